@@ -1,0 +1,644 @@
+// The scallop hull and its offset in one left-to-right pass with a stack.
+// See include/scallop/scallop_hull.hpp for the contract and the outline of the method.
+
+#include "scallop/scallop_hull.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <fmt/format.h>
+
+#include "scallop/error.hpp"
+
+namespace scallop {
+namespace {
+
+constexpr double kRelativeTolerance = 1e-12;  // tau = kRelativeTolerance * scale (header)
+
+double arcTop(const Point2& centre, double r, double x) {
+  // Upper semicircle z = c_z + sqrt(r^2 - d^2), written as (r - |d|)(r + |d|) so the value
+  // stays accurate near the vertical tangents |d| = r.
+  const double d = std::abs(x - centre.x);
+  const double h = (r - d) * (r + d);
+  return centre.z + (h > 0.0 ? std::sqrt(h) : 0.0);
+}
+
+// The top of the capsule of edge e_i = (a, b) (all centres within r of the edge) as a
+// function of x over [a.x - r, b.x + r]: arc around a on [left, s0], the edge's offset line
+// a + r n .. b + r n on [s0, s1], arc around b on [s1, right] (the paper's Figure 3). A
+// vertical or zero-length edge is one arc around its upper end point.
+struct Capsule {
+  Point2 a;
+  Point2 b;
+  double r = 0.0;
+  double nx = 0.0;  // upward unit normal of a -> b (nz > 0); unused when vertical
+  double nz = 1.0;
+  double s0 = 0.0;  // x range of the offset line
+  double s1 = 0.0;
+  bool vertical = false;
+
+  [[nodiscard]] double left() const { return a.x - r; }
+  [[nodiscard]] double right() const { return b.x + r; }
+  [[nodiscard]] const Point2& upperEnd() const { return a.z >= b.z ? a : b; }
+  // The point where the capsule's top ends on the right, at x = right(): level with b, or
+  // with the upper end of a vertical edge.
+  [[nodiscard]] const Point2& upperEndAtRight() const { return vertical ? upperEnd() : b; }
+
+  // Point of the offset line at parameter t in [0, 1] (t = 0 above a, t = 1 above b).
+  [[nodiscard]] Point2 linePoint(double t) const {
+    if (t <= 0.0) return {a.x + r * nx, a.z + r * nz};
+    if (t >= 1.0) return {b.x + r * nx, b.z + r * nz};
+    return {a.x + r * nx + t * (b.x - a.x), a.z + r * nz + t * (b.z - a.z)};
+  }
+  // Line parameter of abscissa x, clamped to [0, 1]; exact 0 and 1 at the ends, so the
+  // end points of a nearly vertical offset line never depend on a division by its width.
+  [[nodiscard]] double lineParameter(double x) const {
+    if (x <= s0) return 0.0;
+    if (x >= s1) return 1.0;
+    return std::clamp((x - s0) / (b.x - a.x), 0.0, 1.0);
+  }
+
+  [[nodiscard]] double top(double x) const {
+    if (vertical) return arcTop(upperEnd(), r, x);
+    if (x <= s0) return arcTop(a, r, x);
+    if (x >= s1) return arcTop(b, r, x);
+    return linePoint(lineParameter(x)).z;
+  }
+};
+
+// The capsule of a -> b with a known upward unit normal (nx, nz) (ignored if vertical).
+Capsule capsuleWithNormal(const Point2& a, const Point2& b, double r, double nx, double nz) {
+  Capsule c;
+  c.a = a;
+  c.b = b;
+  c.r = r;
+  if (!(b.x > a.x)) {
+    c.vertical = true;
+    return c;
+  }
+  c.nx = nx;
+  c.nz = nz;
+  c.s0 = a.x + r * nx;
+  c.s1 = b.x + r * nx;
+  return c;
+}
+
+Capsule makeCapsule(const Point2& a, const Point2& b, double r) {
+  const double dx = b.x - a.x;
+  const double dz = b.z - a.z;
+  if (!(dx > 0.0)) return capsuleWithNormal(a, b, r, 0.0, 0.0);
+  double length = std::sqrt(dx * dx + dz * dz);
+  if (!(length > 0.0) || !std::isfinite(length)) length = std::hypot(dx, dz);
+  return capsuleWithNormal(a, b, r, -dz / length, dx / length);
+}
+
+// True when p is within distance r of the segment a-b, i.e. inside the capsule. For a point
+// on the current envelope (the start of a stacked piece) this is the same as "the capsule's
+// top is on or above p": the envelope lies above the arc around a = v_k, and so above the
+// capsule's lower boundary. It needs neither a square root nor a division. (Points of a
+// stacked capsule beyond its piece are not on the envelope: for those use isBelowTop.)
+bool withinRadius(const Point2& p, const Point2& a, const Point2& b, double r) {
+  const double dx = b.x - a.x;
+  const double dz = b.z - a.z;
+  const double px = p.x - a.x;
+  const double pz = p.z - a.z;
+  const double r2 = r * r;
+  const double dot = px * dx + pz * dz;
+  if (dot <= 0.0) return px * px + pz * pz <= r2;
+  const double length2 = dx * dx + dz * dz;
+  if (dot >= length2) {
+    const double qx = p.x - b.x;
+    const double qz = p.z - b.z;
+    return qx * qx + qz * qz <= r2;
+  }
+  const double cross = px * dz - pz * dx;
+  return cross * cross <= r2 * length2;
+}
+
+// True when (x, z) is on or below the top of capsule c (and x within its reach).
+bool isBelowTop(const Capsule& c, double x, double z) {
+  return x >= c.left() && x <= c.right() && c.top(x) >= z;
+}
+
+// One analytic piece of a capsule top: an upper arc of radius r, or a straight line.
+struct Feature {
+  bool isArc = true;
+  Point2 point;            // arc: centre; line: a point on the line
+  double dx = 0.0;         // line: direction (dx > 0)
+  double dz = 0.0;
+};
+
+Feature featureAt(const Capsule& c, double x) {
+  if (c.vertical) return {true, c.upperEnd(), 0.0, 0.0};
+  if (x < c.s0) return {true, c.a, 0.0, 0.0};
+  if (x > c.s1) return {true, c.b, 0.0, 0.0};
+  return {false, c.linePoint(0.0), c.b.x - c.a.x, c.b.z - c.a.z};
+}
+
+// Abscissae where two features are equal: at most two. Everything is computed relative to
+// `origin` so that coordinates far from zero (1e6) do not cost precision. The three cases
+// are the paper's support pairs (Figure 6):
+//   line-line (slope-slope): the offset lines meet where cross(p2 - p1, d2) = t cross(d1, d2);
+//   arc-arc (peak-peak): equal circles meet on the perpendicular bisector of their centres,
+//     at height sqrt(r^2 - d^2/4) above the midpoint; the upper point is the one reached by
+//     turning c2 - c1 counter-clockwise (centres are x-ordered);
+//   line-arc (peak-slope): |p + t u - c|^2 = r^2 with u the unit direction, a quadratic in t,
+//     kept only where the point is on the upper half of the circle.
+int featureRoots(const Feature& f, const Feature& g, double r, std::array<double, 2>& roots) {
+  const Point2 origin = f.point;
+  auto local = [&](const Point2& p) { return Point2{p.x - origin.x, p.z - origin.z}; };
+  int count = 0;
+  if (!f.isArc && !g.isArc) {
+    const Point2 p1{0.0, 0.0};
+    const Point2 p2 = local(g.point);
+    const double denom = f.dx * g.dz - f.dz * g.dx;
+    if (denom == 0.0) return 0;
+    const double t = ((p2.x - p1.x) * g.dz - (p2.z - p1.z) * g.dx) / denom;
+    roots[count++] = origin.x + t * f.dx;
+    return count;
+  }
+  if (f.isArc && g.isArc) {
+    Point2 c1{0.0, 0.0};
+    Point2 c2 = local(g.point);
+    if (c2.x < c1.x) std::swap(c1, c2);
+    const double wx = c2.x - c1.x;
+    const double wz = c2.z - c1.z;
+    const double d2 = wx * wx + wz * wz;
+    if (d2 == 0.0 || d2 > 4.0 * r * r) return 0;
+    const double d = std::sqrt(d2);
+    const double h = std::sqrt(std::max(0.0, r * r - 0.25 * d2));
+    roots[count++] = origin.x + 0.5 * (c1.x + c2.x) - h * wz / d;
+    return count;
+  }
+  const Feature& line = f.isArc ? g : f;
+  const Feature& arc = f.isArc ? f : g;
+  const Point2 p = local(line.point);
+  const Point2 c = local(arc.point);
+  const double len = std::hypot(line.dx, line.dz);
+  const double ux = line.dx / len;
+  const double uz = line.dz / len;
+  const double wx = p.x - c.x;
+  const double wz = p.z - c.z;
+  const double b = wx * ux + wz * uz;
+  const double cc = (wx * wx + wz * wz) - r * r;
+  const double disc = b * b - cc;
+  if (disc < 0.0) return 0;
+  // Stable quadratic roots of t^2 + 2 b t + cc = 0.
+  const double q = -(b + std::copysign(std::sqrt(disc), b));
+  std::array<double, 2> ts{q, q != 0.0 ? cc / q : 0.0};
+  for (double t : ts) {
+    const double zOnLine = p.z + t * uz;
+    if (zOnLine < c.z - 1e-9 * r) continue;  // lower half of the circle: not on the arc
+    roots[count++] = origin.x + p.x + t * ux;
+  }
+  if (count == 2 && roots[0] > roots[1]) std::swap(roots[0], roots[1]);
+  return count;
+}
+
+// The abscissa in [s, e] where T's curve enters capsule K for good, given that T's
+// feature f is outside K at s and inside at e: the largest intersection of f with one of
+// K's features (each on its own x range) whose right side is inside K.
+double crossingOnFeature(const Capsule& t, const Capsule& k, double s, double e) {
+  const Feature f = featureAt(t, 0.5 * (s + e));
+  auto fz = [&](double x) {
+    if (f.isArc) return arcTop(f.point, t.r, x);
+    return t.linePoint(t.lineParameter(x)).z;
+  };
+  std::array<double, 6> roots{};
+  int count = 0;
+  auto collect = [&](const Feature& g, double from, double to) {
+    from = std::max(from, s);
+    to = std::min(to, e);
+    if (from > to) return;
+    if (f.isArc && g.isArc && f.point == g.point) {
+      // The same arc (a vertex shared by both edges, or a repeated point): K equals T on
+      // the whole common range, so it may take over at its start.
+      roots[count++] = from;
+      return;
+    }
+    std::array<double, 2> found{};
+    const int n = featureRoots(f, g, t.r, found);
+    for (int i = 0; i < n; ++i) {
+      // A root a rounding error outside its range still marks the crossing there.
+      const double slack = 1e-9 * (to - from) + 4.0 * std::numeric_limits<double>::epsilon() *
+                                                    (std::abs(from) + std::abs(to) + t.r);
+      if (found[i] >= from - slack && found[i] <= to + slack) {
+        roots[count++] = std::clamp(found[i], from, to);
+      }
+    }
+  };
+  if (k.vertical) {
+    collect({true, k.upperEnd(), 0.0, 0.0}, k.left(), k.right());
+  } else {
+    collect({true, k.a, 0.0, 0.0}, k.left(), k.s0);
+    collect({false, k.linePoint(0.0), k.b.x - k.a.x, k.b.z - k.a.z}, k.s0, k.s1);
+    collect({true, k.b, 0.0, 0.0}, k.s1, k.right());
+  }
+  for (int i = 1; i < count; ++i) {  // insertion sort, descending
+    for (int j = i; j > 0 && roots[j - 1] < roots[j]; --j) std::swap(roots[j - 1], roots[j]);
+  }
+  double next = e;
+  for (int i = 0; i < count; ++i) {
+    const double root = roots[i];
+    if (root >= next) continue;
+    const double mid = 0.5 * (root + next);
+    if (!isBelowTop(k, mid, fz(mid))) break;
+    next = root;
+  }
+  if (next < e) return next;
+  // No usable root: the curves are tangent or nearly coincide (a double root lost to
+  // rounding, circles around nearly equal centres). Bisect on the inside test instead,
+  // keeping T's point outside K at `outside` and inside at `inside`.
+  double outside = s;
+  double inside = e;
+  for (int i = 0; i < 200; ++i) {
+    const double mid = 0.5 * (outside + inside);
+    if (mid <= outside || mid >= inside) break;
+    (isBelowTop(k, mid, fz(mid)) ? inside : outside) = mid;
+  }
+  return inside;
+}
+
+// The abscissa x* in [lo, hi] from which capsule K is on or above capsule T, given K >= T
+// at hi and T's value zLo at lo. By the ordering of contacts, T's curve enters K once and
+// stays inside: walk T's breakpoints from the right (where T's value is exact: the ends of
+// its offset line) with the inside test, then solve on the one feature where it enters.
+double crossing(const Capsule& t, const Capsule& k, double lo, double hi, double zLo) {
+  double e = hi;
+  if (!t.vertical) {
+    const std::array<Point2, 2> breaks{t.linePoint(1.0), t.linePoint(0.0)};
+    const std::array<double, 2> xs{t.s1, t.s0};
+    for (std::size_t i = 0; i < 2; ++i) {
+      if (!(xs[i] > lo && xs[i] < e)) continue;
+      if (isBelowTop(k, xs[i], breaks[i].z)) {
+        e = xs[i];
+        continue;
+      }
+      return crossingOnFeature(t, k, xs[i], e);
+    }
+  }
+  if (isBelowTop(k, lo, zLo)) return lo;
+  return crossingOnFeature(t, k, lo, e);
+}
+
+struct StackEntry {
+  std::size_t edge = 0;
+  double x = 0.0;   // where this edge's capsule takes over the envelope
+  double z = 0.0;   // the capsule's top there
+  double nx = 0.0;  // the edge's upward unit normal, kept to avoid recomputing it
+  double nz = 0.0;
+};
+
+// Builds the tool path and the hull from the envelope: the stack lists the capsules that
+// form c(x), each from its start to the next one's start.
+class OutputBuilder {
+ public:
+  OutputBuilder(std::span<const Point2> chain, double r, double tau, ScallopHull& out)
+      : chain_(chain), r_(r), tau_(tau), out_(out) {}
+
+  void build(const std::vector<StackEntry>& stack) {
+    const Point2 first = chain_.front();
+    const Point2 last = chain_.back();
+    end_ = {first.x - r_, first.z};
+    contact_ = first;
+    std::size_t previousEdge = 0;
+    for (std::size_t i = 0; i < stack.size(); ++i) {
+      const StackEntry& entry = stack[i];
+      const Capsule c =
+          capsuleWithNormal(chain_[entry.edge], chain_[entry.edge + 1], r_, entry.nx, entry.nz);
+      const double to = i + 1 < stack.size() ? stack[i + 1].x : c.right();
+      // A difference in height where one capsule hands over to the next is the ball sliding
+      // along a vertical edge (or, at the start, the first edge rising vertically).
+      const std::size_t fromEdge = i == 0 ? 0 : previousEdge;
+      verticalTo(entry.z, fromEdge, entry.edge);
+      emitCapsule(c, entry.edge, std::max(entry.x, end_.x), to);
+      previousEdge = entry.edge;
+    }
+    // At the end, the ball may still have to slide down a final vertical edge; the path
+    // then ends exactly at (x_{n-1} + r, z_{n-1}) (a rounding-level gap is snapped).
+    verticalTo(last.z, previousEdge, chain_.size() - 2);
+    const Point2 finalPoint{last.x + r_, last.z};
+    if (!(end_ == finalPoint)) {
+      if (near(end_, finalPoint) && !out_.toolpath.empty()) {
+        out_.toolpath.back().end = finalPoint;
+        end_ = finalPoint;
+      } else {
+        lineTo(finalPoint, chain_.size() - 2, contact_, contact_);
+      }
+    }
+    closeWithLid(last);
+  }
+
+ private:
+  [[nodiscard]] bool near(const Point2& p, const Point2& q) const {
+    return std::abs(p.x - q.x) <= tau_ && std::abs(p.z - q.z) <= tau_;
+  }
+
+  // A lid from the current contact point to `next`, centred at the current path point.
+  void closeWithLid(const Point2& next) {
+    if (!near(contact_, next)) {
+      HullElement lid;
+      lid.kind = HullElementKind::lid;
+      lid.start = contact_;
+      lid.end = next;
+      lid.center = end_;
+      // Lids that coincide (the same centre, within tau) are one lid (the paper's COINCIDE).
+      if (!out_.hull.empty() && out_.hull.back().kind == HullElementKind::lid &&
+          near(out_.hull.back().center, end_)) {
+        out_.hull.back().end = next;
+      } else {
+        out_.hull.push_back(lid);
+      }
+    }
+    contact_ = next;
+  }
+
+  void addLink(const Point2& from, const Point2& to, std::size_t edge) {
+    if (near(from, to)) return;
+    if (!out_.hull.empty() && out_.hull.back().kind == HullElementKind::link &&
+        out_.hull.back().edge == edge && near(out_.hull.back().end, from)) {
+      out_.hull.back().end = to;
+      return;
+    }
+    HullElement link;
+    link.kind = HullElementKind::link;
+    link.start = from;
+    link.end = to;
+    link.edge = edge;
+    out_.hull.push_back(link);
+  }
+
+  // Appends a straight move to `to` whose contact runs from contactFrom to contactTo on
+  // edge `edge`.
+  void lineTo(const Point2& to, std::size_t edge, const Point2& contactFrom,
+              const Point2& contactTo) {
+    closeWithLid(contactFrom);
+    if (near(end_, to)) return;
+    PathElement line;
+    line.kind = PathElementKind::line;
+    line.start = end_;
+    line.end = {std::max(to.x, end_.x), to.z};
+    line.feature = edge;
+    out_.toolpath.push_back(line);
+    end_ = line.end;
+    addLink(contactFrom, contactTo, edge);
+    contact_ = contactTo;
+  }
+
+  void arcTo(const Point2& to, std::size_t vertex) {
+    const Point2& centre = chain_[vertex];
+    closeWithLid(centre);
+    if (near(end_, to)) return;
+    if (!out_.toolpath.empty() && out_.toolpath.back().kind == PathElementKind::arc &&
+        out_.toolpath.back().center == centre && out_.toolpath.back().end == end_) {
+      out_.toolpath.back().end = {std::max(to.x, end_.x), to.z};
+      end_ = out_.toolpath.back().end;
+      return;
+    }
+    PathElement arc;
+    arc.kind = PathElementKind::arc;
+    arc.start = end_;
+    arc.end = {std::max(to.x, end_.x), to.z};
+    arc.center = centre;
+    arc.radius = r_;
+    arc.clockwise = true;
+    arc.feature = vertex;
+    out_.toolpath.push_back(arc);
+    end_ = arc.end;
+  }
+
+  // Vertical slide from the current path point to height z at the same x: the ball rolls
+  // along the vertical edges among fromEdge..toEdge that stand at the wall's abscissa.
+  void verticalTo(double z, std::size_t fromEdge, std::size_t toEdge) {
+    if (std::abs(z - end_.z) <= tau_) return;
+    const bool down = z < end_.z;
+    const double wallX = down ? end_.x - r_ : end_.x + r_;
+    const double zFrom = end_.z;
+    // Contacts run along the wall from height zFrom to z; each vertical edge at wallX
+    // contributes the part of it within that range, in chain order.
+    const double lo = std::min(zFrom, z);
+    const double hi = std::max(zFrom, z);
+    Point2 contactStart{wallX, zFrom};
+    closeWithLid(contactStart);
+    PathElement line;
+    line.kind = PathElementKind::line;
+    line.start = end_;
+    line.end = {end_.x, z};
+    line.feature = fromEdge;
+    for (std::size_t e = fromEdge; e <= toEdge && e + 1 < chain_.size(); ++e) {
+      const Point2& a = chain_[e];
+      const Point2& b = chain_[e + 1];
+      if (a.x != b.x || std::abs(a.x - wallX) > tau_) continue;
+      const double za = std::clamp(a.z, lo, hi);
+      const double zb = std::clamp(b.z, lo, hi);
+      if (za == zb) continue;
+      line.feature = e;
+      addLink({a.x, za}, {a.x, zb}, e);
+    }
+    out_.toolpath.push_back(line);
+    end_ = line.end;
+    contact_ = {wallX, z};
+  }
+
+  // The pieces of capsule c (edge `edge`) over [from, to]: arc around a, offset line, arc
+  // around b.
+  void emitCapsule(const Capsule& c, std::size_t edge, double from, double to) {
+    if (to < from) to = from;
+    if (c.vertical) {
+      const std::size_t vertex = c.a.z >= c.b.z ? edge : edge + 1;
+      arcTo({to, arcTop(c.upperEnd(), r_, to)}, vertex);
+      return;
+    }
+    if (from < c.s0) arcTo({std::min(to, c.s0), arcTop(c.a, r_, std::min(to, c.s0))}, edge);
+    if (to >= c.s0 && from <= c.s1) {
+      const double t0 = c.lineParameter(from);
+      const double t1 = c.lineParameter(to);
+      if (t1 > t0) {
+        const Point2 ea{c.a.x + t0 * (c.b.x - c.a.x), c.a.z + t0 * (c.b.z - c.a.z)};
+        const Point2 eb{c.a.x + t1 * (c.b.x - c.a.x), c.a.z + t1 * (c.b.z - c.a.z)};
+        lineTo(c.linePoint(t1), edge, t0 <= 0.0 ? c.a : ea, t1 >= 1.0 ? c.b : eb);
+      }
+    }
+    if (to > c.s1) arcTo({to, arcTop(c.b, r_, to)}, edge + 1);
+  }
+
+  std::span<const Point2> chain_;
+  double r_;
+  double tau_;
+  ScallopHull& out_;
+  Point2 end_;      // current end of the tool path
+  Point2 contact_;  // current contact point on the chain
+};
+
+void hullForInfiniteRadius(std::span<const Point2> chain, ScallopHull& out) {
+  const std::vector<std::size_t> vertices = upperHullIndices(chain);
+  for (std::size_t i = 0; i + 1 < vertices.size(); ++i) {
+    const std::size_t a = vertices[i];
+    const std::size_t b = vertices[i + 1];
+    if (chain[a] == chain[b]) continue;
+    HullElement element;
+    element.start = chain[a];
+    element.end = chain[b];
+    if (b == a + 1) {
+      element.kind = HullElementKind::link;
+      element.edge = a;
+    } else {
+      element.kind = HullElementKind::lid;
+      element.straight = true;
+    }
+    out.hull.push_back(element);
+  }
+}
+
+}  // namespace
+
+std::vector<std::size_t> upperHullIndices(std::span<const Point2> chain) {
+  std::vector<std::size_t> hull;
+  hull.reserve(chain.size());
+  for (std::size_t i = 0; i < chain.size(); ++i) {
+    const Point2& p = chain[i];
+    // Pop the last vertex while it lies strictly below the segment from its predecessor to
+    // p (a strict left turn); collinear vertices stay: the chain touches the hull there.
+    while (hull.size() >= 2) {
+      const Point2& a = chain[hull[hull.size() - 2]];
+      const Point2& b = chain[hull.back()];
+      const double cross = (b.x - a.x) * (p.z - a.z) - (b.z - a.z) * (p.x - a.x);
+      if (cross > 0.0) {
+        hull.pop_back();
+      } else {
+        break;
+      }
+    }
+    hull.push_back(i);
+  }
+  return hull;
+}
+
+ScallopHull scallopHull(std::span<const Point2> chain, double radius) {
+  validateChain(chain);
+  if (!(radius > 0.0)) {
+    throw Error(fmt::format("the radius must be a positive number, got {}", radius));
+  }
+  ScallopHull out;
+  out.radius = radius;
+  if (std::isinf(radius)) {
+    hullForInfiniteRadius(chain, out);
+    return out;
+  }
+  const double r = radius;
+  const double scale = std::max(r, coordinateScale(chain));
+  const double tau = kRelativeTolerance * scale;
+
+  std::vector<StackEntry> stack;
+  stack.reserve(std::min<std::size_t>(chain.size(), std::size_t{1} << 20));
+  HullStats& stats = out.stats;
+  auto push = [&](std::size_t edge, double x, double z, const Capsule& c) {
+    stack.push_back({edge, x, z, c.nx, c.nz});
+    ++stats.pushes;
+  };
+  for (std::size_t k = 0; k + 1 < chain.size(); ++k) {
+    const Capsule K = makeCapsule(chain[k], chain[k + 1], r);
+    // Backward exclusion: K covers the whole piece of the top capsule when it is on or above
+    // it where that piece starts (contacts are ordered, so K stays above from there on).
+    double poppedFrom = K.left();
+    while (!stack.empty()) {
+      const StackEntry& top = stack.back();
+      ++stats.comparisons;
+      if (!withinRadius({top.x, top.z}, K.a, K.b, r)) break;
+      poppedFrom = top.x;
+      stack.pop_back();
+      ++stats.pops;
+    }
+    if (stack.empty()) {
+      push(k, poppedFrom, K.top(poppedFrom), K);
+      continue;
+    }
+    const StackEntry& top = stack.back();
+    const Capsule T =
+        capsuleWithNormal(chain[top.edge], chain[top.edge + 1], r, top.nx, top.nz);
+    const double hi = T.right();
+    const double lo = std::min(std::max(top.x, K.left()), hi);
+    ++stats.comparisons;
+    if (top.edge + 1 == k && !T.vertical && !K.vertical) {
+      // Adjacent edges meeting at v = chain[k]: K's capsule holds the disk around v, so K is
+      // above T where T ends, and the hand-over is known in closed form.
+      const double turn =
+          (T.b.x - T.a.x) * (K.b.z - K.a.z) - (T.b.z - T.a.z) * (K.b.x - K.a.x);
+      if (turn <= 0.0) {
+        // Convex (or straight) at v: both capsules are the arc around v between the two
+        // offset lines, so K takes over where T's offset line ends.
+        if (T.s1 >= lo && T.s1 <= hi) {
+          push(k, T.s1, T.b.z + r * T.nz, K);
+        } else {
+          const double start = std::clamp(T.s1, lo, hi);
+          push(k, start, K.top(start), K);
+        }
+        continue;
+      }
+      // Concave at v (slope-slope, Figure 6a): the offset lines meet at
+      // v + r (n_T + n_K) / (1 + n_T . n_K), the centre at distance r from both lines.
+      const double denom = 1.0 + T.nx * K.nx + T.nz * K.nz;
+      if (denom > 1e-8) {
+        const double qx = T.b.x + r * (T.nx + K.nx) / denom;
+        if (qx >= lo && qx >= T.s0 && qx <= T.s1 && qx >= K.s0 && qx <= K.s1) {
+          push(k, qx, T.b.z + r * (T.nz + K.nz) / denom, K);
+          continue;
+        }
+      }
+    } else if (!isBelowTop(K, hi, T.upperEndAtRight().z)) {
+      // K is below T where T ends: it takes over only beyond T's reach (the ball drops
+      // along a vertical edge there), or never.
+      if (K.right() > hi) push(k, hi, K.top(hi), K);
+      continue;
+    }
+    const double zLo = lo == top.x ? top.z : T.top(lo);
+    const double start = crossing(T, K, lo, hi, zLo);
+    push(k, start, K.top(start), K);
+  }
+
+  out.toolpath.reserve(2 * stack.size() + 4);
+  out.hull.reserve(2 * stack.size() + 4);
+  OutputBuilder(chain, r, tau, out).build(stack);
+  return out;
+}
+
+double pathHeightAt(std::span<const PathElement> toolpath, double x) {
+  // Elements are ordered with non-decreasing x, so those whose x range holds x are
+  // contiguous: find the first that ends at or after x.
+  auto it = std::lower_bound(toolpath.begin(), toolpath.end(), x,
+                             [](const PathElement& e, double value) { return e.end.x < value; });
+  double best = -std::numeric_limits<double>::infinity();
+  for (; it != toolpath.end() && it->start.x <= x; ++it) {
+    const PathElement& e = *it;
+    double z;
+    if (e.kind == PathElementKind::arc) {
+      z = arcTop(e.center, e.radius, x);
+    } else if (e.end.x == e.start.x) {
+      z = std::max(e.start.z, e.end.z);
+    } else {
+      const double t = (x - e.start.x) / (e.end.x - e.start.x);
+      z = e.start.z + t * (e.end.z - e.start.z);
+    }
+    best = std::max(best, z);
+  }
+  return best;
+}
+
+double pathLength(std::span<const PathElement> toolpath) {
+  double length = 0.0;
+  for (const PathElement& e : toolpath) {
+    if (e.kind == PathElementKind::line) {
+      length += std::hypot(e.end.x - e.start.x, e.end.z - e.start.z);
+    } else {
+      const double a0 = std::atan2(e.start.z - e.center.z, e.start.x - e.center.x);
+      const double a1 = std::atan2(e.end.z - e.center.z, e.end.x - e.center.x);
+      double sweep = e.clockwise ? a0 - a1 : a1 - a0;
+      if (sweep < 0.0) sweep += 2.0 * std::numbers::pi;
+      length += e.radius * sweep;
+    }
+  }
+  return length;
+}
+
+}  // namespace scallop
