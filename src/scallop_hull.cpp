@@ -7,6 +7,9 @@
 #include <array>
 #include <cmath>
 #include <numbers>
+#include <optional>
+#include <cstdio>
+#include <cstdlib>
 #include <fmt/format.h>
 
 #include "scallop/error.hpp"
@@ -60,6 +63,11 @@ struct Capsule {
   }
 
   [[nodiscard]] double top(double x) const {
+    // At its two ends the top is level with a (or the upper end of a vertical edge) and
+    // with b, exactly: evaluating the circle there would amplify the rounding of x - c.x
+    // into an error of sqrt(2 r ulp) in z.
+    if (x <= left()) return vertical ? upperEnd().z : a.z;
+    if (x >= right()) return upperEndAtRight().z;
     if (vertical) return arcTop(upperEnd(), r, x);
     if (x <= s0) return arcTop(a, r, x);
     if (x >= s1) return arcTop(b, r, x);
@@ -98,22 +106,40 @@ Capsule makeCapsule(const Point2& a, const Point2& b, double r) {
 // top is on or above p": the envelope lies above the arc around a = v_k, and so above the
 // capsule's lower boundary. It needs neither a square root nor a division. (Points of a
 // stacked capsule beyond its piece are not on the envelope: for those use isBelowTop.)
+// |(u, w)|^2 - r^2 >= 0 up to rounding, written as (|u| - r)(|u| + r) + w^2 with |u| the
+// larger component: no cancellation when a point lies near the extreme of a circle (one
+// component ~ r), where the plain difference of squares loses all precision once r is
+// large.
+bool outsideCircle(double u, double w, double r) {
+  u = std::abs(u);
+  w = std::abs(w);
+  if (u < w) std::swap(u, w);
+  return (u - r) * (u + r) + w * w > 0.0;
+}
+
 bool withinRadius(const Point2& p, const Point2& a, const Point2& b, double r) {
   const double dx = b.x - a.x;
   const double dz = b.z - a.z;
   const double px = p.x - a.x;
   const double pz = p.z - a.z;
-  const double r2 = r * r;
   const double dot = px * dx + pz * dz;
-  if (dot <= 0.0) return px * px + pz * pz <= r2;
+  if (dot <= 0.0) return !outsideCircle(px, pz, r);
   const double length2 = dx * dx + dz * dz;
-  if (dot >= length2) {
-    const double qx = p.x - b.x;
-    const double qz = p.z - b.z;
-    return qx * qx + qz * qz <= r2;
-  }
+  if (dot >= length2) return !outsideCircle(p.x - b.x, p.z - b.z, r);
+  // Distance to the line: |cross| / length <= r (squared: both sides carry the same
+  // relative rounding, so the decision is as accurate as the distance itself).
   const double cross = px * dz - pz * dx;
-  return cross * cross <= r2 * length2;
+  return cross * cross <= (r * r) * length2;
+}
+
+// Parameter of the foot of p on the offset line of c (0 above a, 1 above b), not clamped:
+// points of the arc around a project below 0 and those of the arc around b above 1. Well
+// conditioned for a line of any slope, where reading it off x is not (near-vertical).
+double projectOnLine(const Capsule& c, const Point2& p) {
+  const Point2 origin = c.linePoint(0.0);
+  const double dx = c.b.x - c.a.x;
+  const double dz = c.b.z - c.a.z;
+  return ((p.x - origin.x) * dx + (p.z - origin.z) * dz) / (dx * dx + dz * dz);
 }
 
 // True when (x, z) is on or below the top of capsule c (and x within its reach).
@@ -136,26 +162,28 @@ Feature featureAt(const Capsule& c, double x) {
   return {false, c.linePoint(0.0), c.b.x - c.a.x, c.b.z - c.a.z};
 }
 
-// Abscissae where two features are equal: at most two. Everything is computed relative to
-// `origin` so that coordinates far from zero (1e6) do not cost precision. The three cases
-// are the paper's support pairs (Figure 6):
+// Points where two features meet: at most two, ordered by x. Everything is computed
+// relative to `origin` so that coordinates far from zero (1e6) do not cost precision, and
+// each point comes from the parametric solution, so that it is accurate even on a
+// near-vertical line (where x alone would not fix z). The three cases are the paper's
+// support pairs (Figure 6):
 //   line-line (slope-slope): the offset lines meet where cross(p2 - p1, d2) = t cross(d1, d2);
 //   arc-arc (peak-peak): equal circles meet on the perpendicular bisector of their centres,
 //     at height sqrt(r^2 - d^2/4) above the midpoint; the upper point is the one reached by
 //     turning c2 - c1 counter-clockwise (centres are x-ordered);
 //   line-arc (peak-slope): |p + t u - c|^2 = r^2 with u the unit direction, a quadratic in t,
 //     kept only where the point is on the upper half of the circle.
-int featureRoots(const Feature& f, const Feature& g, double r, std::array<double, 2>& roots) {
+int featureRoots(const Feature& f, const Feature& g, double r, std::array<Point2, 2>& roots) {
   const Point2 origin = f.point;
   auto local = [&](const Point2& p) { return Point2{p.x - origin.x, p.z - origin.z}; };
+  auto global = [&](double x, double z) { return Point2{origin.x + x, origin.z + z}; };
   int count = 0;
   if (!f.isArc && !g.isArc) {
-    const Point2 p1{0.0, 0.0};
     const Point2 p2 = local(g.point);
     const double denom = f.dx * g.dz - f.dz * g.dx;
     if (denom == 0.0) return 0;
-    const double t = ((p2.x - p1.x) * g.dz - (p2.z - p1.z) * g.dx) / denom;
-    roots[count++] = origin.x + t * f.dx;
+    const double t = (p2.x * g.dz - p2.z * g.dx) / denom;
+    roots[count++] = global(t * f.dx, t * f.dz);
     return count;
   }
   if (f.isArc && g.isArc) {
@@ -168,14 +196,18 @@ int featureRoots(const Feature& f, const Feature& g, double r, std::array<double
     if (d2 == 0.0 || d2 > 4.0 * r * r) return 0;
     const double d = std::sqrt(d2);
     const double h = std::sqrt(std::max(0.0, r * r - 0.25 * d2));
-    roots[count++] = origin.x + 0.5 * (c1.x + c2.x) - h * wz / d;
+    // Both arcs are upper halves: the meeting point must not lie below either centre
+    // (centres one above the other meet only below the upper one).
+    const double z = 0.5 * (c1.z + c2.z) + h * wx / d;
+    if (z < std::max(c1.z, c2.z) - 1e-9 * r) return 0;
+    roots[count++] = global(0.5 * (c1.x + c2.x) - h * wz / d, z);
     return count;
   }
   const Feature& line = f.isArc ? g : f;
   const Feature& arc = f.isArc ? f : g;
   const Point2 p = local(line.point);
   const Point2 c = local(arc.point);
-  const double len = std::hypot(line.dx, line.dz);
+  const double len = std::sqrt(line.dx * line.dx + line.dz * line.dz);  // dx > 0: no 0/0
   const double ux = line.dx / len;
   const double uz = line.dz / len;
   const double wx = p.x - c.x;
@@ -183,29 +215,39 @@ int featureRoots(const Feature& f, const Feature& g, double r, std::array<double
   const double b = wx * ux + wz * uz;
   const double cc = (wx * wx + wz * wz) - r * r;
   const double disc = b * b - cc;
-  if (disc < 0.0) return 0;
-  // Stable quadratic roots of t^2 + 2 b t + cc = 0.
-  const double q = -(b + std::copysign(std::sqrt(disc), b));
-  std::array<double, 2> ts{q, q != 0.0 ? cc / q : 0.0};
-  for (double t : ts) {
-    const double zOnLine = p.z + t * uz;
-    if (zOnLine < c.z - 1e-9 * r) continue;  // lower half of the circle: not on the arc
-    roots[count++] = origin.x + p.x + t * ux;
+  // Within its rounding error (about epsilon r^2) the discriminant says "tangent": take the
+  // double root t = -b, the foot of the perpendicular from the centre, which is well
+  // conditioned, where sqrt(disc) would scatter the root by sqrt(epsilon) r.
+  const double discNoise = 8.0 * std::numeric_limits<double>::epsilon() *
+                           std::max({b * b, std::abs(cc), r * r});
+  if (disc < -discNoise) return 0;
+  std::array<double, 2> ts{-b, -b};
+  int distinct = 1;
+  if (disc > discNoise) {
+    // Stable quadratic roots of t^2 + 2 b t + cc = 0.
+    const double q = -(b + std::copysign(std::sqrt(disc), b));
+    ts = {q, q != 0.0 ? cc / q : 0.0};
+    distinct = 2;
   }
-  if (count == 2 && roots[0] > roots[1]) std::swap(roots[0], roots[1]);
+  for (int i = 0; i < distinct; ++i) {
+    const double zOnLine = p.z + ts[i] * uz;
+    if (zOnLine < c.z - 1e-9 * r) continue;  // lower half of the circle: not on the arc
+    roots[count++] = global(p.x + ts[i] * ux, zOnLine);
+  }
+  if (count == 2 && roots[0].x > roots[1].x) std::swap(roots[0], roots[1]);
   return count;
 }
 
-// The abscissa in [s, e] where T's curve enters capsule K for good, given that T's
-// feature f is outside K at s and inside at e: the largest intersection of f with one of
-// K's features (each on its own x range) whose right side is inside K.
-double crossingOnFeature(const Capsule& t, const Capsule& k, double s, double e) {
+// The point in [s, e] where T's curve enters capsule K for good, given that T's feature f
+// is outside K at s and inside at e, where T's height is zE: the rightmost meeting point of
+// f with one of K's features (each on its own x range) whose right side is inside K.
+Point2 crossingOnFeature(const Capsule& t, const Capsule& k, double s, double e, double zE) {
   const Feature f = featureAt(t, 0.5 * (s + e));
   auto fz = [&](double x) {
     if (f.isArc) return arcTop(f.point, t.r, x);
     return t.linePoint(t.lineParameter(x)).z;
   };
-  std::array<double, 6> roots{};
+  std::array<Point2, 6> roots{};
   int count = 0;
   auto collect = [&](const Feature& g, double from, double to) {
     from = std::max(from, s);
@@ -214,17 +256,17 @@ double crossingOnFeature(const Capsule& t, const Capsule& k, double s, double e)
     if (f.isArc && g.isArc && f.point == g.point) {
       // The same arc (a vertex shared by both edges, or a repeated point): K equals T on
       // the whole common range, so it may take over at its start.
-      roots[count++] = from;
+      roots[count++] = {from, fz(from)};
       return;
     }
-    std::array<double, 2> found{};
+    std::array<Point2, 2> found{};
     const int n = featureRoots(f, g, t.r, found);
     for (int i = 0; i < n; ++i) {
       // A root a rounding error outside its range still marks the crossing there.
       const double slack = 1e-9 * (to - from) + 4.0 * std::numeric_limits<double>::epsilon() *
                                                     (std::abs(from) + std::abs(to) + t.r);
-      if (found[i] >= from - slack && found[i] <= to + slack) {
-        roots[count++] = std::clamp(found[i], from, to);
+      if (found[i].x >= from - slack && found[i].x <= to + slack) {
+        roots[count++] = {std::clamp(found[i].x, from, to), found[i].z};
       }
     }
   };
@@ -235,37 +277,51 @@ double crossingOnFeature(const Capsule& t, const Capsule& k, double s, double e)
     collect({false, k.linePoint(0.0), k.b.x - k.a.x, k.b.z - k.a.z}, k.s0, k.s1);
     collect({true, k.b, 0.0, 0.0}, k.s1, k.right());
   }
-  for (int i = 1; i < count; ++i) {  // insertion sort, descending
-    for (int j = i; j > 0 && roots[j - 1] < roots[j]; --j) std::swap(roots[j - 1], roots[j]);
+  for (int i = 1; i < count; ++i) {  // insertion sort, descending in x
+    for (int j = i; j > 0 && roots[j - 1].x < roots[j].x; --j) std::swap(roots[j - 1], roots[j]);
   }
-  double next = e;
+  // A point of f between two points of f: on a line the midpoint of the two points (which
+  // stays on the line however steep it is), on an arc the point above the middle abscissa.
+  auto between = [&](const Point2& p, const Point2& q) {
+    if (!f.isArc) return Point2{0.5 * (p.x + q.x), 0.5 * (p.z + q.z)};
+    const double x = 0.5 * (p.x + q.x);
+    return Point2{x, fz(x)};
+  };
+  Point2 best{e, zE};
   for (int i = 0; i < count; ++i) {
-    const double root = roots[i];
-    if (root >= next) continue;
-    const double mid = 0.5 * (root + next);
-    if (!isBelowTop(k, mid, fz(mid))) break;
-    next = root;
+    const Point2 root = roots[i];
+    if (root.x > best.x || root == best) continue;
+    const Point2 mid = between(root, best);
+    if (!isBelowTop(k, mid.x, mid.z)) break;
+    best = root;
   }
-  if (next < e) return next;
-  // No usable root: the curves are tangent or nearly coincide (a double root lost to
-  // rounding, circles around nearly equal centres). Bisect on the inside test instead,
-  // keeping T's point outside K at `outside` and inside at `inside`.
-  double outside = s;
-  double inside = e;
+  if (!(best == Point2{e, zE})) return best;
+  // No usable root: the curves are tangent or nearly coincide. If they touch at e (T's
+  // offset line running into the arc around its end point, which K shares), e is the
+  // crossing: a tangent root is only known to sqrt(epsilon), but the junction exactly.
+  const double touch = 1e-12 * std::max({t.r, std::abs(e), std::abs(zE)});
+  if (std::abs(k.top(e) - zE) <= touch) return {e, zE};
+  // Otherwise a double root was lost to rounding (circles around nearly equal centres):
+  // bisect on the inside test, keeping T's point outside K at `outside`, inside at `inside`.
+  Point2 outside = f.isArc ? Point2{s, fz(s)} : t.linePoint(t.lineParameter(s));
+  Point2 inside{e, zE};
   for (int i = 0; i < 200; ++i) {
-    const double mid = 0.5 * (outside + inside);
-    if (mid <= outside || mid >= inside) break;
-    (isBelowTop(k, mid, fz(mid)) ? inside : outside) = mid;
+    const Point2 mid = between(outside, inside);
+    if (mid == outside || mid == inside) break;
+    (isBelowTop(k, mid.x, mid.z) ? inside : outside) = mid;
   }
   return inside;
 }
 
-// The abscissa x* in [lo, hi] from which capsule K is on or above capsule T, given K >= T
-// at hi and T's value zLo at lo. By the ordering of contacts, T's curve enters K once and
-// stays inside: walk T's breakpoints from the right (where T's value is exact: the ends of
-// its offset line) with the inside test, then solve on the one feature where it enters.
-double crossing(const Capsule& t, const Capsule& k, double lo, double hi, double zLo) {
+// The point from which capsule K is on or above capsule T, in [lo, hi], given K >= T at hi
+// (T's height there zHi) and T's height zLo at lo. By the ordering of contacts, T's curve
+// enters K once and stays inside: walk T's breakpoints from the right (where T's value is
+// exact: the ends of its offset line) with isBelowTop, then solve on the one feature where
+// it enters.
+Point2 crossing(const Capsule& t, const Capsule& k, double lo, double hi, double zLo,
+                double zHi) {
   double e = hi;
+  double zE = zHi;
   if (!t.vertical) {
     const std::array<Point2, 2> breaks{t.linePoint(1.0), t.linePoint(0.0)};
     const std::array<double, 2> xs{t.s1, t.s0};
@@ -273,13 +329,14 @@ double crossing(const Capsule& t, const Capsule& k, double lo, double hi, double
       if (!(xs[i] > lo && xs[i] < e)) continue;
       if (isBelowTop(k, xs[i], breaks[i].z)) {
         e = xs[i];
+        zE = breaks[i].z;
         continue;
       }
-      return crossingOnFeature(t, k, xs[i], e);
+      return crossingOnFeature(t, k, xs[i], e, zE);
     }
   }
-  if (isBelowTop(k, lo, zLo)) return lo;
-  return crossingOnFeature(t, k, lo, e);
+  if (isBelowTop(k, lo, zLo)) return {lo, zLo};
+  return crossingOnFeature(t, k, lo, e, zE);
 }
 
 struct StackEntry {
@@ -288,10 +345,20 @@ struct StackEntry {
   double z = 0.0;   // the capsule's top there
   double nx = 0.0;  // the edge's upward unit normal, kept to avoid recomputing it
   double nz = 0.0;
+  bool jump = false;  // the envelope jumps there (the ball slides along a vertical edge)
 };
 
 // Builds the tool path and the hull from the envelope: the stack lists the capsules that
 // form c(x), each from its start to the next one's start.
+HullElement pointHull(std::span<const Point2> chain) {
+  HullElement link;
+  link.kind = HullElementKind::link;
+  link.start = chain.front();
+  link.end = chain.back();
+  link.edge = 0;
+  return link;
+}
+
 class OutputBuilder {
  public:
   OutputBuilder(std::span<const Point2> chain, double r, double tau, ScallopHull& out)
@@ -310,9 +377,11 @@ class OutputBuilder {
       const double to = i + 1 < stack.size() ? stack[i + 1].x : c.right();
       // A difference in height where one capsule hands over to the next is the ball sliding
       // along a vertical edge (or, at the start, the first edge rising vertically).
-      const std::size_t fromEdge = i == 0 ? 0 : previousEdge;
-      verticalTo(entry.z, fromEdge, entry.edge);
-      emitCapsule(c, entry.edge, std::max(entry.x, end_.x), to);
+      // Elsewhere the two capsules cross, and the path goes on from where it is.
+      if (i == 0 || entry.jump) verticalTo(entry.z, i == 0 ? 0 : previousEdge, entry.edge);
+      std::optional<Point2> handOver;
+      if (i + 1 < stack.size() && !stack[i + 1].jump) handOver = {stack[i + 1].x, stack[i + 1].z};
+      emitCapsule(c, entry.edge, std::max(entry.x, end_.x), to, handOver);
       previousEdge = entry.edge;
     }
     // At the end, the ball may still have to slide down a final vertical edge; the path
@@ -328,6 +397,15 @@ class OutputBuilder {
       }
     }
     closeWithLid(last);
+    // The hull runs exactly from v_0 to v_{n-1} (contacts computed as x -+ r may differ from
+    // them by a rounding error).
+    if (!out_.hull.empty()) {
+      if (near(out_.hull.front().start, first)) out_.hull.front().start = first;
+      if (near(out_.hull.back().end, last)) out_.hull.back().end = last;
+    }
+    // A chain whose points all coincide touches the ball at one point: the hull is that
+    // point, a zero-length link, so that it still runs from v_0 to v_{n-1}.
+    if (out_.hull.empty()) out_.hull.push_back(pointHull(chain_));
   }
 
  private:
@@ -414,53 +492,91 @@ class OutputBuilder {
     if (std::abs(z - end_.z) <= tau_) return;
     const bool down = z < end_.z;
     const double wallX = down ? end_.x - r_ : end_.x + r_;
-    const double zFrom = end_.z;
-    // Contacts run along the wall from height zFrom to z; each vertical edge at wallX
-    // contributes the part of it within that range, in chain order.
-    const double lo = std::min(zFrom, z);
-    const double hi = std::max(zFrom, z);
-    Point2 contactStart{wallX, zFrom};
-    closeWithLid(contactStart);
-    PathElement line;
-    line.kind = PathElementKind::line;
-    line.start = end_;
-    line.end = {end_.x, z};
-    line.feature = fromEdge;
+    closeWithLid({wallX, end_.z});
+    // The vertical edges at wallX among fromEdge..toEdge, in chain order, each carry the
+    // ball on as far as they reach in the slide's direction: one path line and one link
+    // per edge, never backwards (a vertical zigzag is climbed once).
+    auto progress = [&](double from, double to) { return down ? to < from : to > from; };
+    auto clampToSlide = [&](double v) { return down ? std::max(v, z) : std::min(v, z); };
+    std::size_t lastWall = fromEdge;
     for (std::size_t e = fromEdge; e <= toEdge && e + 1 < chain_.size(); ++e) {
       const Point2& a = chain_[e];
       const Point2& b = chain_[e + 1];
       if (a.x != b.x || std::abs(a.x - wallX) > tau_) continue;
-      const double za = std::clamp(a.z, lo, hi);
-      const double zb = std::clamp(b.z, lo, hi);
-      if (za == zb) continue;
-      line.feature = e;
-      addLink({a.x, za}, {a.x, zb}, e);
+      lastWall = e;
+      const double target = clampToSlide(b.z);
+      // The edge must hold the current height and lead on in the slide's direction.
+      const double low = std::min(a.z, b.z);
+      const double high = std::max(a.z, b.z);
+      if (!progress(end_.z, target) || end_.z < low - tau_ || end_.z > high + tau_) continue;
+      slideTo(target, e, a.x);  // contacts on the wall itself, not at end_.x -+ r
     }
+    if (std::abs(z - end_.z) > tau_) slideTo(z, lastWall, wallX);
+    end_.z = z;
+    if (!out_.toolpath.empty() && out_.toolpath.back().kind == PathElementKind::line &&
+        out_.toolpath.back().end.x == end_.x) {
+      out_.toolpath.back().end.z = z;  // land exactly on z (a rounding-level remainder)
+    }
+    contact_ = {wallX, z};
+  }
+
+  // One vertical path line from the current point to height z, offsetting vertical edge
+  // `edge` at wallX, and its link.
+  void slideTo(double z, std::size_t edge, double wallX) {
+    PathElement line;
+    line.kind = PathElementKind::line;
+    line.start = end_;
+    line.end = {end_.x, z};
+    line.feature = edge;
     out_.toolpath.push_back(line);
+    addLink({wallX, end_.z}, {wallX, z}, edge);
     end_ = line.end;
     contact_ = {wallX, z};
   }
 
-  // The pieces of capsule c (edge `edge`) over [from, to]: arc around a, offset line, arc
-  // around b.
-  void emitCapsule(const Capsule& c, std::size_t edge, double from, double to) {
+  // The pieces of capsule c (edge `edge`) from the current path point to abscissa `to`: arc
+  // around a, offset line, arc around b. When the next capsule takes over at `to` without a
+  // jump, `handOver` is that point and the last piece ends on it. Which piece a point is on
+  // is told by its projection on the offset line, not by its x.
+  void emitCapsule(const Capsule& c, std::size_t edge, double from, double to,
+                   const std::optional<Point2>& handOver) {
     if (to < from) to = from;
+    auto endAt = [&](double x) { return handOver ? *handOver : Point2{x, c.top(x)}; };
     if (c.vertical) {
-      const std::size_t vertex = c.a.z >= c.b.z ? edge : edge + 1;
-      arcTo({to, arcTop(c.upperEnd(), r_, to)}, vertex);
+      arcTo(endAt(to), c.a.z >= c.b.z ? edge : edge + 1);
       return;
     }
-    if (from < c.s0) arcTo({std::min(to, c.s0), arcTop(c.a, r_, std::min(to, c.s0))}, edge);
-    if (to >= c.s0 && from <= c.s1) {
-      const double t0 = c.lineParameter(from);
-      const double t1 = c.lineParameter(to);
-      if (t1 > t0) {
-        const Point2 ea{c.a.x + t0 * (c.b.x - c.a.x), c.a.z + t0 * (c.b.z - c.a.z)};
-        const Point2 eb{c.a.x + t1 * (c.b.x - c.a.x), c.a.z + t1 * (c.b.z - c.a.z)};
-        lineTo(c.linePoint(t1), edge, t0 <= 0.0 ? c.a : ea, t1 >= 1.0 ? c.b : eb);
-      }
+    enum class Piece { arcA, line, arcB };
+    double t1 = 1.0;  // where the piece stops on the line, if it stops there
+    Piece stop = Piece::arcB;
+    if (handOver) {
+      const double t = projectOnLine(c, *handOver);
+      stop = t <= 0.0 ? Piece::arcA : (t < 1.0 ? Piece::line : Piece::arcB);
+      t1 = std::clamp(t, 0.0, 1.0);
+    } else if (to < c.s0) {
+      stop = Piece::arcA;
+    } else if (to < c.s1) {
+      stop = Piece::line;
+      t1 = c.lineParameter(to);
     }
-    if (to > c.s1) arcTo({to, arcTop(c.b, r_, to)}, edge + 1);
+    const double t0raw = projectOnLine(c, end_);
+    const double t0 = std::clamp(t0raw, 0.0, 1.0);
+    if (t0raw <= 0.0 && from < c.s1) {
+      // The arc around a ends where the offset line begins (its tangent point, exactly).
+      arcTo(stop == Piece::arcA ? endAt(to) : c.linePoint(0.0), edge);
+    }
+    if (stop == Piece::arcA) return;
+    if (t1 > t0 && t0 < 1.0) {
+      auto onEdge = [&](double t) {
+        if (t <= 0.0) return c.a;
+        if (t >= 1.0) return c.b;
+        return Point2{c.a.x + t * (c.b.x - c.a.x), c.a.z + t * (c.b.z - c.a.z)};
+      };
+      Point2 pathEnd = c.linePoint(1.0);
+      if (stop == Piece::line) pathEnd = handOver ? *handOver : Point2{to, c.linePoint(t1).z};
+      lineTo(pathEnd, edge, onEdge(t0), onEdge(t1));
+    }
+    if (stop == Piece::arcB) arcTo(endAt(to), edge + 1);
   }
 
   std::span<const Point2> chain_;
@@ -471,8 +587,50 @@ class OutputBuilder {
   Point2 contact_;  // current contact point on the chain
 };
 
+std::vector<std::size_t> monotoneUpperHull(std::span<const Point2> chain, HullStats& stats) {
+  // Andrew's monotone chain over points already ordered by x. Ties in x (vertical edges)
+  // and repeated points need care: the turn test must compare a vertex with the last
+  // *distinct* vertex before it, or a repeated point would block every later pop. Each
+  // kept vertex records where its run of repeats starts, so that lookup is O(1).
+  struct Kept {
+    std::size_t index;
+    std::size_t runStart;  // position in `kept` of the first vertex equal to this one
+  };
+  std::vector<Kept> kept;
+  kept.reserve(std::min<std::size_t>(chain.size(), std::size_t{1} << 16));
+  for (std::size_t i = 0; i < chain.size(); ++i) {
+    const Point2& p = chain[i];
+    while (!kept.empty()) {
+      const Kept& last = kept.back();
+      if (last.runStart == 0) break;  // nothing distinct before it
+      const Point2& b = chain[last.index];
+      const Point2& a = chain[kept[last.runStart - 1].index];
+      const double cross = (b.x - a.x) * (p.z - a.z) - (b.z - a.z) * (p.x - a.x);
+      // Pop b (with its repeats) when it lies strictly below the segment a-p, or when it
+      // is collinear but not between a and p (a reversal along a vertical edge). Collinear
+      // vertices between a and p stay: the chain touches the hull there.
+      const double along = (b.x - a.x) * (p.x - b.x) + (b.z - a.z) * (p.z - b.z);
+      ++stats.comparisons;
+      if (cross > 0.0 || (cross == 0.0 && along < 0.0)) {
+        stats.pops += kept.size() - last.runStart;
+        kept.resize(last.runStart);
+      } else {
+        break;
+      }
+    }
+    const std::size_t position = kept.size();
+    const bool repeat = !kept.empty() && chain[kept.back().index] == p;
+    kept.push_back({i, repeat ? kept.back().runStart : position});
+    if (i > 0) ++stats.pushes;  // v_i closes edge e_{i-1}: one push per edge
+  }
+  std::vector<std::size_t> hull;
+  hull.reserve(kept.size());
+  for (const Kept& k : kept) hull.push_back(k.index);
+  return hull;
+}
+
 void hullForInfiniteRadius(std::span<const Point2> chain, ScallopHull& out) {
-  const std::vector<std::size_t> vertices = upperHullIndices(chain);
+  const std::vector<std::size_t> vertices = monotoneUpperHull(chain, out.stats);
   for (std::size_t i = 0; i + 1 < vertices.size(); ++i) {
     const std::size_t a = vertices[i];
     const std::size_t b = vertices[i + 1];
@@ -489,30 +647,14 @@ void hullForInfiniteRadius(std::span<const Point2> chain, ScallopHull& out) {
     }
     out.hull.push_back(element);
   }
+  if (out.hull.empty()) out.hull.push_back(pointHull(chain));
 }
 
 }  // namespace
 
 std::vector<std::size_t> upperHullIndices(std::span<const Point2> chain) {
-  std::vector<std::size_t> hull;
-  hull.reserve(chain.size());
-  for (std::size_t i = 0; i < chain.size(); ++i) {
-    const Point2& p = chain[i];
-    // Pop the last vertex while it lies strictly below the segment from its predecessor to
-    // p (a strict left turn); collinear vertices stay: the chain touches the hull there.
-    while (hull.size() >= 2) {
-      const Point2& a = chain[hull[hull.size() - 2]];
-      const Point2& b = chain[hull.back()];
-      const double cross = (b.x - a.x) * (p.z - a.z) - (b.z - a.z) * (p.x - a.x);
-      if (cross > 0.0) {
-        hull.pop_back();
-      } else {
-        break;
-      }
-    }
-    hull.push_back(i);
-  }
-  return hull;
+  HullStats unused;
+  return monotoneUpperHull(chain, unused);
 }
 
 ScallopHull scallopHull(std::span<const Point2> chain, double radius) {
@@ -533,8 +675,8 @@ ScallopHull scallopHull(std::span<const Point2> chain, double radius) {
   std::vector<StackEntry> stack;
   stack.reserve(std::min<std::size_t>(chain.size(), std::size_t{1} << 20));
   HullStats& stats = out.stats;
-  auto push = [&](std::size_t edge, double x, double z, const Capsule& c) {
-    stack.push_back({edge, x, z, c.nx, c.nz});
+  auto push = [&](std::size_t edge, double x, double z, const Capsule& c, bool jump = false) {
+    stack.push_back({edge, x, z, c.nx, c.nz, jump});
     ++stats.pushes;
   };
   for (std::size_t k = 0; k + 1 < chain.size(); ++k) {
@@ -542,11 +684,19 @@ ScallopHull scallopHull(std::span<const Point2> chain, double radius) {
     // Backward exclusion: K covers the whole piece of the top capsule when it is on or above
     // it where that piece starts (contacts are ordered, so K stays above from there on).
     double poppedFrom = K.left();
+    bool poppedJump = false;
     while (!stack.empty()) {
       const StackEntry& top = stack.back();
       ++stats.comparisons;
-      if (!withinRadius({top.x, top.z}, K.a, K.b, r)) break;
+      // On the capsule's boundary (within rounding) the distance test cannot tell; there,
+      // as at the extremes of a circle, the height test can: ask it in that case only.
+      if (!withinRadius({top.x, top.z}, K.a, K.b, r) &&
+          (!withinRadius({top.x, top.z}, K.a, K.b, r * (1.0 + 1e-9)) ||
+           !isBelowTop(K, top.x, top.z))) {
+        break;
+      }
       poppedFrom = top.x;
+      poppedJump = top.jump;
       stack.pop_back();
       ++stats.pops;
     }
@@ -578,27 +728,41 @@ ScallopHull scallopHull(std::span<const Point2> chain, double radius) {
       }
       // Concave at v (slope-slope, Figure 6a): the offset lines meet at
       // v + r (n_T + n_K) / (1 + n_T . n_K), the centre at distance r from both lines.
+      // It is the hand-over if it lies on both offset lines' segments (tested by projection,
+      // which a near-vertical line's x range cannot do).
       const double denom = 1.0 + T.nx * K.nx + T.nz * K.nz;
       if (denom > 1e-8) {
-        const double qx = T.b.x + r * (T.nx + K.nx) / denom;
-        if (qx >= lo && qx >= T.s0 && qx <= T.s1 && qx >= K.s0 && qx <= K.s1) {
-          push(k, qx, T.b.z + r * (T.nz + K.nz) / denom, K);
+        const Point2 q{T.b.x + r * (T.nx + K.nx) / denom, T.b.z + r * (T.nz + K.nz) / denom};
+        const double tT = projectOnLine(T, q);
+        const double tK = projectOnLine(K, q);
+        if (q.x >= lo && tT >= 0.0 && tT <= 1.0 && tK >= 0.0 && tK <= 1.0) {
+          push(k, q.x, q.z, K);
           continue;
         }
       }
     } else if (!isBelowTop(K, hi, T.upperEndAtRight().z)) {
       // K is below T where T ends: it takes over only beyond T's reach (the ball drops
       // along a vertical edge there), or never.
-      if (K.right() > hi) push(k, hi, K.top(hi), K);
+      if (K.right() > hi) push(k, hi, K.top(hi), K, true);
       continue;
     }
     const double zLo = lo == top.x ? top.z : T.top(lo);
-    const double start = crossing(T, K, lo, hi, zLo);
-    push(k, start, K.top(start), K);
+    const Point2 handOver = crossing(T, K, lo, hi, zLo, T.upperEndAtRight().z);
+    const double start = handOver.x;
+    // Taking over where a vertical K begins, K may start above T: the ball climbs the
+    // vertical edge. (A non-vertical K starts at the equator of the circle around K.a, and
+    // the capsule before it holds that circle: no jump.) Taking over where T began, T's
+    // piece is empty and K inherits its hand-over; likewise where a popped piece began.
+    const bool jump = (start == K.left() && K.vertical) || (start == top.x && top.jump) ||
+                      (start == poppedFrom && poppedJump);
+    // After a jump the piece starts at K's own height there; otherwise at the crossing
+    // point, computed on the curves themselves (well conditioned on a near-vertical line).
+    push(k, start, jump ? K.top(start) : handOver.z, K, jump);
   }
 
   out.toolpath.reserve(2 * stack.size() + 4);
   out.hull.reserve(2 * stack.size() + 4);
+  if (std::getenv("SCALLOP_DEBUG")) for (auto& e : stack) std::fprintf(stderr, "entry edge %zu x %.17g z %.17g jump %d\n", e.edge, e.x, e.z, int(e.jump));
   OutputBuilder(chain, r, tau, out).build(stack);
   return out;
 }

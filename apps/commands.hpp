@@ -1,0 +1,15 @@
+#pragma once
+// The scallop program's subcommands. Each one adds itself to the top-level CLI11 app and
+// does its work from the subcommand's callback; every error it meets propagates out of
+// CLI::App::parse to main(), the one place errors are caught and reported.
+
+namespace CLI {
+class App;
+}  // namespace CLI
+
+namespace scallop::cli {
+
+/// `scallop hull`: the scallop hull of a chain and its tool-centre path, as JSON and/or SVG.
+void addHullCommand(CLI::App& app);
+
+}  // namespace scallop::cli

@@ -1,0 +1,283 @@
+// End-to-end tests of the `scallop` program: each run happens in a fresh temporary
+// directory; failures must exit non-zero, say what and where (file, line, value), and leave
+// no output file and no temporary behind; the happy path writes JSON and SVG that agree
+// with the library.
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "scallop/chain.hpp"
+#include "scallop/chain_io.hpp"
+
+namespace scallop {
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+
+struct RunResult {
+  int exitCode = -1;
+  std::string out;
+  std::string err;
+};
+
+std::string readFile(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// A fresh directory for one run, and a second one for the captured stdout/stderr so that
+// the run's directory holds only what the program itself created.
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    workDir_ = makeTempDir("scallop-cli-");
+    captureDir_ = makeTempDir("scallop-cli-capture-");
+  }
+  void TearDown() override {
+    fs::remove_all(workDir_);
+    fs::remove_all(captureDir_);
+  }
+
+  static fs::path makeTempDir(const std::string& prefix) {
+    std::string pattern = (fs::temp_directory_path() / (prefix + "XXXXXX")).string();
+    if (::mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
+    return pattern;
+  }
+
+  void write(const std::string& name, const std::string& content) const {
+    std::ofstream(workDir_ / name, std::ios::binary) << content;
+  }
+
+  // Runs `scallop <arguments>` in the work directory. Arguments are passed through the
+  // shell: tests quote them as needed.
+  RunResult run(const std::string& arguments, const std::string& stdinFile = "") const {
+    const fs::path out = captureDir_ / "stdout";
+    const fs::path err = captureDir_ / "stderr";
+    std::string command = "cd '" + workDir_.string() + "' && '" SCALLOP_CLI_PATH "' " + arguments +
+                          " > '" + out.string() + "' 2> '" + err.string() + "'";
+    if (!stdinFile.empty()) command += " < '" + stdinFile + "'";
+    const int status = std::system(command.c_str());
+    RunResult result;
+    result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    result.out = readFile(out);
+    result.err = readFile(err);
+    return result;
+  }
+
+  std::vector<std::string> listing() const {
+    std::vector<std::string> names;
+    for (const auto& entry : fs::directory_iterator(workDir_)) {
+      names.push_back(entry.path().filename().string());
+    }
+    std::sort(names.begin(), names.end());
+    return names;
+  }
+
+  fs::path workDir_;
+  fs::path captureDir_;
+};
+
+// ---------------------------------------------------------------------------------------
+// Bad input: non-zero exit, a message naming the place and value, nothing written.
+// ---------------------------------------------------------------------------------------
+
+struct BadRun {
+  const char* what;
+  const char* inputName;  // nullptr: no input file is created
+  const char* content;
+  const char* arguments;  // after "hull"; output options are appended
+  std::vector<std::string> messageParts;
+};
+
+const std::vector<BadRun>& badRuns() {
+  static const std::vector<BadRun> runs = {
+      {"x decreasing",
+       "in.txt",
+       "0 0\n1 1\n# comment\n0.5 2\n",
+       "in.txt -r 1",
+       {"in.txt:4:", "'0.5'"}},
+      {"NaN coordinate", "in.txt", "0 0\n1 nan\n", "in.txt -r 1", {"in.txt:2:", "'nan'"}},
+      {"infinite coordinate", "in.txt", "0 0\ninf 1\n", "in.txt -r 1", {"in.txt:2:", "'inf'"}},
+      {"one point", "in.txt", "0 0\n", "in.txt -r 1", {"in.txt:1:", "at least 2"}},
+      {"empty file", "in.txt", "", "in.txt -r 1", {"in.txt", "no points"}},
+      {"malformed line", "in.txt", "0 0\n1 2 3\n", "in.txt -r 1", {"in.txt:2:", "'3'"}},
+      {"trailing garbage", "in.txt", "0 0\n1 2x\n", "in.txt -r 1", {"in.txt:2:", "'2x'"}},
+      {"malformed JSON",
+       "in.json",
+       "{\"points\": [[0, 0], [1, 2]\n",
+       "in.json -r 1",
+       {"in.json", "line 2"}},
+      {"bad JSON point",
+       "in.json",
+       "{\"points\": [[0, 0], [1, \"2\"]]}",
+       "in.json -r 1",
+       {"in.json", "points[1]"}},
+      {"r zero", "in.txt", "0 0\n1 1\n", "in.txt -r 0", {"radius", "'0'"}},
+      {"r negative", "in.txt", "0 0\n1 1\n", "in.txt --radius=-2.5", {"radius", "'-2.5'"}},
+      {"r NaN", "in.txt", "0 0\n1 1\n", "in.txt -r nan", {"radius", "'nan'"}},
+      {"r not a number", "in.txt", "0 0\n1 1\n", "in.txt -r abc", {"radius", "'abc'"}},
+      {"r trailing garbage", "in.txt", "0 0\n1 1\n", "in.txt -r 1mm", {"radius", "'1mm'"}},
+      {"tolerance zero", "in.txt", "0 0\n1 1\n", "in.txt -r 1 --tolerance 0", {"tolerance", "'0'"}},
+      {"missing file", nullptr, "", "missing.txt -r 1", {"missing.txt", "No such file"}},
+  };
+  return runs;
+}
+
+TEST_F(Cli, BadInputFailsWithMessageAndWritesNothing) {
+  for (const BadRun& bad : badRuns()) {
+    SCOPED_TRACE(bad.what);
+    fs::remove_all(workDir_);
+    fs::create_directory(workDir_);
+    if (bad.inputName != nullptr) write(bad.inputName, bad.content);
+    const RunResult result =
+        run(std::string("hull ") + bad.arguments + " --json out.json --svg out.svg");
+    EXPECT_EQ(result.exitCode, 1);
+    EXPECT_NE(result.err.find("scallop: error: "), std::string::npos) << result.err;
+    for (const std::string& part : bad.messageParts) {
+      EXPECT_NE(result.err.find(part), std::string::npos)
+          << "stderr '" << result.err << "' lacks '" << part << "'";
+    }
+    EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+    EXPECT_TRUE(result.out.empty()) << result.out;
+    const std::vector<std::string> expected = bad.inputName == nullptr
+                                                  ? std::vector<std::string>{}
+                                                  : std::vector<std::string>{bad.inputName};
+    EXPECT_EQ(listing(), expected);
+  }
+}
+
+TEST_F(Cli, UsageErrorsFailWithoutOutput) {
+  write("in.txt", "0 0\n1 1\n");
+  for (const char* arguments :
+       {"", "hull --json out.json -r 1", "hull in.txt --example figure2 -r 1 --json out.json",
+        "hull --example nope -r 1 --json out.json", "hull in.txt --json out.json",
+        "hull in.txt -r 1 --bogus", "hull in.txt -r 1 --json - --svg -"}) {
+    SCOPED_TRACE(arguments);
+    const RunResult result = run(arguments);
+    EXPECT_NE(result.exitCode, 0);
+    EXPECT_FALSE(result.err.empty());
+    EXPECT_EQ(listing(), std::vector<std::string>{"in.txt"});
+  }
+}
+
+TEST_F(Cli, UnwritableSecondOutputRemovesTheFirst) {
+  write("in.txt", "0 0\n1 1\n2 0\n");
+  for (const char* outputs :
+       {"--json out.json --svg nodir/out.svg", "--json nodir/out.json --svg out.svg"}) {
+    SCOPED_TRACE(outputs);
+    const RunResult result = run(std::string("hull in.txt -r 0.5 ") + outputs);
+    EXPECT_EQ(result.exitCode, 1);
+    EXPECT_NE(result.err.find("nodir/out."), std::string::npos) << result.err;
+    EXPECT_EQ(listing(), std::vector<std::string>{"in.txt"});
+  }
+}
+
+// ---------------------------------------------------------------------------------------
+// Happy paths
+// ---------------------------------------------------------------------------------------
+
+Point2 pointOf(const Json& json) { return {json.at(0).get<double>(), json.at(1).get<double>()}; }
+
+// Each element starts exactly where the previous one ends; the path runs from
+// (x_0 - r, z_0) to (x_{n-1} + r, z_{n-1}).
+void expectContiguousToolPath(const Json& doc, const Chain& chain, double r) {
+  const Json& path = doc.at("toolpath");
+  ASSERT_FALSE(path.empty());
+  for (std::size_t i = 1; i < path.size(); ++i) {
+    EXPECT_EQ(pointOf(path[i].at("start")), pointOf(path[i - 1].at("end"))) << "element " << i;
+  }
+  const Point2 first = pointOf(path.front().at("start"));
+  const Point2 last = pointOf(path.back().at("end"));
+  EXPECT_NEAR(first.x, chain.front().x - r, 1e-12);
+  EXPECT_NEAR(first.z, chain.front().z, 1e-12);
+  EXPECT_NEAR(last.x, chain.back().x + r, 1e-12);
+  EXPECT_NEAR(last.z, chain.back().z, 1e-12);
+}
+
+TEST_F(Cli, WritesJsonAndSvg) {
+  const RunResult result =
+      run("hull --example figure2 --radius 1 --json out.json --svg out.svg --tolerance 0.01");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  EXPECT_EQ(listing(), (std::vector<std::string>{"out.json", "out.svg"}));
+  EXPECT_TRUE(result.out.empty());
+  EXPECT_NE(result.err.find("n = 27"), std::string::npos) << result.err;
+
+  const Json doc = Json::parse(readFile(workDir_ / "out.json"));
+  const Chain chain = exampleChain("figure2");
+  EXPECT_EQ(doc.at("radius").get<double>(), 1.0);
+  EXPECT_EQ(doc.at("stats").at("vertices").get<std::size_t>(), chain.size());
+  expectContiguousToolPath(doc, chain, 1.0);
+  const Json& polyline = doc.at("polyline");
+  ASSERT_GE(polyline.size(), 2u);
+  EXPECT_EQ(pointOf(polyline.front()), pointOf(doc["toolpath"].front().at("start")));
+  EXPECT_EQ(pointOf(polyline.back()), pointOf(doc["toolpath"].back().at("end")));
+
+  const std::string svg = readFile(workDir_ / "out.svg");
+  EXPECT_EQ(svg.rfind("<svg", 0), 0u);
+  EXPECT_NE(svg.find("</svg>"), std::string::npos);
+}
+
+TEST_F(Cli, ReplacesExistingOutputs) {
+  write("out.json", "stale");
+  const RunResult result = run("hull --example steps -r 0.5 --json out.json");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  EXPECT_NO_THROW(Json::parse(readFile(workDir_ / "out.json")));
+  EXPECT_EQ(listing(), std::vector<std::string>{"out.json"});
+}
+
+TEST_F(Cli, JsonGoesToStandardOutputByDefault) {
+  const std::string input = (fs::path(SCALLOP_EXAMPLES_DIR) / "chains" / "figure2.txt").string();
+  const RunResult result = run("hull '" + input + "' -r 1");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  EXPECT_TRUE(result.err.empty()) << result.err;  // no summary when stdout carries the JSON
+  expectContiguousToolPath(Json::parse(result.out), readChain(input), 1.0);
+  EXPECT_TRUE(listing().empty());
+}
+
+TEST_F(Cli, ReadsStandardInput) {
+  const std::string input = (fs::path(SCALLOP_EXAMPLES_DIR) / "chains" / "pits.json").string();
+  const RunResult result = run("hull - -r 0.5 --json -", input);
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  expectContiguousToolPath(Json::parse(result.out), readChain(input), 0.5);
+}
+
+TEST_F(Cli, InfiniteRadius) {
+  for (const char* spelling : {"inf", "infinity", "Inf"}) {
+    SCOPED_TRACE(spelling);
+    const RunResult result = run(std::string("hull --example sawtooth -r ") + spelling);
+    ASSERT_EQ(result.exitCode, 0) << result.err;
+    const Json doc = Json::parse(result.out);
+    EXPECT_TRUE(doc.at("radius").is_null());
+    EXPECT_TRUE(doc.at("toolpath").empty());
+    EXPECT_FALSE(doc.at("hull").empty());
+  }
+}
+
+TEST_F(Cli, VersionAndHelp) {
+  const RunResult version = run("--version");
+  EXPECT_EQ(version.exitCode, 0);
+  EXPECT_NE(version.out.find("scallop "), std::string::npos) << version.out;
+
+  const RunResult help = run("hull --help");
+  EXPECT_EQ(help.exitCode, 0);
+  for (const char* part :
+       {"--radius", "--json", "--svg", "--tolerance", "--example", "scallop hull"}) {
+    EXPECT_NE(help.out.find(part), std::string::npos) << part;
+  }
+  EXPECT_TRUE(listing().empty());
+}
+
+}  // namespace
+}  // namespace scallop
