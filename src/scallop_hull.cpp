@@ -8,8 +8,6 @@
 #include <cmath>
 #include <numbers>
 #include <optional>
-#include <cstdio>
-#include <cstdlib>
 #include <fmt/format.h>
 
 #include "scallop/error.hpp"
@@ -76,13 +74,16 @@ struct Capsule {
 };
 
 // The capsule of a -> b with a known upward unit normal (nx, nz) (ignored if vertical).
+// (A vertical capsule is stored with the normal (0, 0).)
 Capsule capsuleWithNormal(const Point2& a, const Point2& b, double r, double nx, double nz) {
   Capsule c;
   c.a = a;
   c.b = b;
   c.r = r;
-  if (!(b.x > a.x)) {
+  if (nz == 0.0) {
     c.vertical = true;
+    c.nx = 0.0;
+    c.nz = 0.0;
     return c;
   }
   c.nx = nx;
@@ -92,10 +93,13 @@ Capsule capsuleWithNormal(const Point2& a, const Point2& b, double r, double nx,
   return c;
 }
 
-Capsule makeCapsule(const Point2& a, const Point2& b, double r) {
+// An edge whose run dx is at most `verticalRun` is taken as vertical: moving its end by dx
+// moves the envelope by at most dx, well inside the tolerance, while on a line a few ulps
+// wide x no longer tells where along it a point is (see Stretch).
+Capsule makeCapsule(const Point2& a, const Point2& b, double r, double verticalRun) {
   const double dx = b.x - a.x;
   const double dz = b.z - a.z;
-  if (!(dx > 0.0)) return capsuleWithNormal(a, b, r, 0.0, 0.0);
+  if (!(dx > verticalRun)) return capsuleWithNormal(a, b, r, 0.0, 0.0);
   double length = std::sqrt(dx * dx + dz * dz);
   if (!(length > 0.0) || !std::isfinite(length)) length = std::hypot(dx, dz);
   return capsuleWithNormal(a, b, r, -dz / length, dx / length);
@@ -155,12 +159,6 @@ struct Feature {
   double dz = 0.0;
 };
 
-Feature featureAt(const Capsule& c, double x) {
-  if (c.vertical) return {true, c.upperEnd(), 0.0, 0.0};
-  if (x < c.s0) return {true, c.a, 0.0, 0.0};
-  if (x > c.s1) return {true, c.b, 0.0, 0.0};
-  return {false, c.linePoint(0.0), c.b.x - c.a.x, c.b.z - c.a.z};
-}
 
 // Points where two features meet: at most two, ordered by x. Everything is computed
 // relative to `origin` so that coordinates far from zero (1e6) do not cost precision, and
@@ -215,11 +213,17 @@ int featureRoots(const Feature& f, const Feature& g, double r, std::array<Point2
   const double b = wx * ux + wz * uz;
   const double cc = (wx * wx + wz * wz) - r * r;
   const double disc = b * b - cc;
-  // Within its rounding error (about epsilon r^2) the discriminant says "tangent": take the
-  // double root t = -b, the foot of the perpendicular from the centre, which is well
-  // conditioned, where sqrt(disc) would scatter the root by sqrt(epsilon) r.
-  const double discNoise = 8.0 * std::numeric_limits<double>::epsilon() *
-                           std::max({b * b, std::abs(cc), r * r});
+  // Within its rounding error the discriminant says "tangent": take the double root t = -b,
+  // the foot of the perpendicular from the centre, which is well conditioned, where
+  // sqrt(disc) would scatter the root by the square root of that error. The error: the
+  // products (about epsilon r^2) and the local coordinates themselves, each off by up to
+  // delta = a few ulps of the global coordinates, which moves |w|^2 by 2 |w| delta.
+  constexpr double eps = std::numeric_limits<double>::epsilon();
+  const double delta = 4.0 * eps * std::max({std::abs(origin.x), std::abs(origin.z),
+                                             std::abs(line.point.x), std::abs(line.point.z),
+                                             std::abs(arc.point.x), std::abs(arc.point.z)});
+  const double discNoise = 8.0 * eps * std::max({b * b, std::abs(cc), r * r}) +
+                           4.0 * (std::abs(wx) + std::abs(wz) + r) * delta;
   if (disc < -discNoise) return 0;
   std::array<double, 2> ts{-b, -b};
   int distinct = 1;
@@ -238,73 +242,124 @@ int featureRoots(const Feature& f, const Feature& g, double r, std::array<Point2
   return count;
 }
 
-// The point in [s, e] where T's curve enters capsule K for good, given that T's feature f
-// is outside K at s and inside at e, where T's height is zE: the rightmost meeting point of
-// f with one of K's features (each on its own x range) whose right side is inside K.
-Point2 crossingOnFeature(const Capsule& t, const Capsule& k, double s, double e, double zE) {
-  const Feature f = featureAt(t, 0.5 * (s + e));
-  auto fz = [&](double x) {
-    if (f.isArc) return arcTop(f.point, t.r, x);
-    return t.linePoint(t.lineParameter(x)).z;
+// Where a point lies along capsule c's top, by its projection on the offset line (see
+// projectOnLine): below 0 on the arc around a, in [0, 1] on the line, above 1 on the arc
+// around b. Told by projection, not by x, so that a near-vertical line (whose x range is a
+// few ulps wide) still has its own stretch.
+enum class Stretch { arcA, line, arcB };
+
+// The stretch of c's top that point p (on or near it) lies on. Where x is decisive (more
+// than a rounding error from the offset line's x range) x tells; otherwise the projection
+// does. Neither alone will do: x cannot tell along a near-vertical line, and the projection
+// cannot tell near the arc's end point level with a vertical edge direction.
+double xMargin(const Capsule& c, const Point2& p) {
+  return 8.0 * std::numeric_limits<double>::epsilon() * (std::abs(p.x) + c.r);
+}
+
+Stretch stretchOf(const Capsule& c, const Point2& p) {
+  if (c.vertical) return Stretch::arcA;
+  const double eta = xMargin(c, p);
+  if (p.x < c.s0 - eta) return Stretch::arcA;
+  if (p.x > c.s1 + eta) return Stretch::arcB;
+  const double t = projectOnLine(c, p);
+  return t <= 0.0 ? Stretch::arcA : (t < 1.0 ? Stretch::line : Stretch::arcB);
+}
+
+// Whether p may lie on the given stretch, allowing rounding-level overshoot at its ends.
+bool onStretch(const Capsule& c, Stretch stretch, const Point2& p) {
+  if (c.vertical) return true;
+  const double eta = 1e-9 * (c.s1 - c.s0) + xMargin(c, p);
+  if (p.x < c.s0 - eta) return stretch == Stretch::arcA;
+  if (p.x > c.s1 + eta) return stretch == Stretch::arcB;
+  constexpr double slack = 1e-9;
+  const double t = projectOnLine(c, p);
+  switch (stretch) {
+    case Stretch::arcA: return t <= slack;
+    case Stretch::line: return t >= -slack && t <= 1.0 + slack;
+    case Stretch::arcB: return t >= 1.0 - slack;
+  }
+  return false;
+}
+
+Feature featureOf(const Capsule& c, Stretch stretch) {
+  if (c.vertical) return {true, c.upperEnd(), 0.0, 0.0};
+  switch (stretch) {
+    case Stretch::arcA: return {true, c.a, 0.0, 0.0};
+    case Stretch::line: return {false, c.linePoint(0.0), c.b.x - c.a.x, c.b.z - c.a.z};
+    case Stretch::arcB: return {true, c.b, 0.0, 0.0};
+  }
+  return {};
+}
+
+// The point where T's curve enters capsule K for good, on the stretch of T from `outside`
+// (a point of T outside K) to `inside` (a point of T inside K, further right): the last
+// meeting point of that stretch with K's top whose continuation towards `inside` is
+// inside K.
+Point2 crossingOnStretch(const Capsule& t, Stretch stretch, const Capsule& k, Point2 outside,
+                         Point2 inside) {
+  const Feature f = featureOf(t, stretch);
+  // A point of the stretch between two of its points: on a line their midpoint (which stays
+  // on the line however steep it is), on an arc the point above the middle abscissa.
+  auto between = [&](const Point2& p, const Point2& q) {
+    if (!f.isArc) return Point2{0.5 * (p.x + q.x), 0.5 * (p.z + q.z)};
+    const double x = 0.5 * (p.x + q.x);
+    return Point2{x, arcTop(f.point, t.r, x)};
   };
+  // Position along the stretch, increasing towards `inside`.
+  auto along = [&](const Point2& p) { return f.isArc ? p.x : projectOnLine(t, p); };
+  const double from = along(outside);
+  const double to = along(inside);
+  const double slack = 1e-9 * std::abs(to - from) + 4.0 * std::numeric_limits<double>::epsilon() *
+                                                      (std::abs(from) + std::abs(to) + 1.0);
   std::array<Point2, 6> roots{};
   int count = 0;
-  auto collect = [&](const Feature& g, double from, double to) {
-    from = std::max(from, s);
-    to = std::min(to, e);
-    if (from > to) return;
+  auto collect = [&](Stretch other) {
+    const Feature g = featureOf(k, other);
     if (f.isArc && g.isArc && f.point == g.point) {
-      // The same arc (a vertex shared by both edges, or a repeated point): K equals T on
-      // the whole common range, so it may take over at its start.
-      roots[count++] = {from, fz(from)};
+      // The same arc (a vertex shared by both edges, or a repeated point): K equals T along
+      // it, so it may take over where that arc begins on this stretch.
+      Point2 start = outside;
+      if (!k.vertical && !onStretch(k, other, start)) return;
+      roots[count++] = start;
       return;
     }
     std::array<Point2, 2> found{};
     const int n = featureRoots(f, g, t.r, found);
     for (int i = 0; i < n; ++i) {
-      // A root a rounding error outside its range still marks the crossing there.
-      const double slack = 1e-9 * (to - from) + 4.0 * std::numeric_limits<double>::epsilon() *
-                                                    (std::abs(from) + std::abs(to) + t.r);
-      if (found[i].x >= from - slack && found[i].x <= to + slack) {
-        roots[count++] = {std::clamp(found[i].x, from, to), found[i].z};
-      }
+      const double position = along(found[i]);
+      if (position < from - slack || position > to + slack) continue;
+      if (!onStretch(k, other, found[i])) continue;
+      roots[count++] = found[i];
     }
   };
   if (k.vertical) {
-    collect({true, k.upperEnd(), 0.0, 0.0}, k.left(), k.right());
+    collect(Stretch::arcA);
   } else {
-    collect({true, k.a, 0.0, 0.0}, k.left(), k.s0);
-    collect({false, k.linePoint(0.0), k.b.x - k.a.x, k.b.z - k.a.z}, k.s0, k.s1);
-    collect({true, k.b, 0.0, 0.0}, k.s1, k.right());
+    collect(Stretch::arcA);
+    collect(Stretch::line);
+    collect(Stretch::arcB);
   }
-  for (int i = 1; i < count; ++i) {  // insertion sort, descending in x
-    for (int j = i; j > 0 && roots[j - 1].x < roots[j].x; --j) std::swap(roots[j - 1], roots[j]);
+  for (int i = 1; i < count; ++i) {  // insertion sort, the furthest along first
+    for (int j = i; j > 0 && along(roots[j - 1]) < along(roots[j]); --j) {
+      std::swap(roots[j - 1], roots[j]);
+    }
   }
-  // A point of f between two points of f: on a line the midpoint of the two points (which
-  // stays on the line however steep it is), on an arc the point above the middle abscissa.
-  auto between = [&](const Point2& p, const Point2& q) {
-    if (!f.isArc) return Point2{0.5 * (p.x + q.x), 0.5 * (p.z + q.z)};
-    const double x = 0.5 * (p.x + q.x);
-    return Point2{x, fz(x)};
-  };
-  Point2 best{e, zE};
+  Point2 best = inside;
   for (int i = 0; i < count; ++i) {
     const Point2 root = roots[i];
-    if (root.x > best.x || root == best) continue;
+    if (along(root) > along(best) || root == best) continue;
     const Point2 mid = between(root, best);
     if (!isBelowTop(k, mid.x, mid.z)) break;
     best = root;
   }
-  if (!(best == Point2{e, zE})) return best;
-  // No usable root: the curves are tangent or nearly coincide. If they touch at e (T's
-  // offset line running into the arc around its end point, which K shares), e is the
-  // crossing: a tangent root is only known to sqrt(epsilon), but the junction exactly.
-  const double touch = 1e-12 * std::max({t.r, std::abs(e), std::abs(zE)});
-  if (std::abs(k.top(e) - zE) <= touch) return {e, zE};
+  if (!(best == inside)) return best;
+  // No usable root: the curves are tangent or nearly coincide. If they touch at `inside`
+  // (T's offset line running into the arc around its end point, which K shares), that is
+  // the crossing: a tangent root is only known to sqrt(epsilon), the junction exactly.
+  const double touch = 1e-12 * std::max({t.r, std::abs(inside.x), std::abs(inside.z)});
+  if (std::abs(k.top(inside.x) - inside.z) <= touch) return inside;
   // Otherwise a double root was lost to rounding (circles around nearly equal centres):
-  // bisect on the inside test, keeping T's point outside K at `outside`, inside at `inside`.
-  Point2 outside = f.isArc ? Point2{s, fz(s)} : t.linePoint(t.lineParameter(s));
-  Point2 inside{e, zE};
+  // bisect on the inside test.
   for (int i = 0; i < 200; ++i) {
     const Point2 mid = between(outside, inside);
     if (mid == outside || mid == inside) break;
@@ -313,30 +368,41 @@ Point2 crossingOnFeature(const Capsule& t, const Capsule& k, double s, double e,
   return inside;
 }
 
-// The point from which capsule K is on or above capsule T, in [lo, hi], given K >= T at hi
-// (T's height there zHi) and T's height zLo at lo. By the ordering of contacts, T's curve
-// enters K once and stays inside: walk T's breakpoints from the right (where T's value is
-// exact: the ends of its offset line) with isBelowTop, then solve on the one feature where
-// it enters.
+// The point from which capsule K is on or above capsule T, between T's points (lo, zLo) and
+// (hi, zHi), given K >= T at hi. By the ordering of contacts, T's curve enters K once and
+// stays inside: walk T's stretches from the right (their end points are exact: the ends of
+// the offset line) with isBelowTop, then solve on the one stretch where it enters.
 Point2 crossing(const Capsule& t, const Capsule& k, double lo, double hi, double zLo,
                 double zHi) {
-  double e = hi;
-  double zE = zHi;
+  const Point2 start{lo, zLo};
+  Point2 inside{hi, zHi};
+  Stretch stretch = Stretch::arcA;  // the stretch of T that ends at `inside`
   if (!t.vertical) {
-    const std::array<Point2, 2> breaks{t.linePoint(1.0), t.linePoint(0.0)};
-    const std::array<double, 2> xs{t.s1, t.s0};
-    for (std::size_t i = 0; i < 2; ++i) {
-      if (!(xs[i] > lo && xs[i] < e)) continue;
-      if (isBelowTop(k, xs[i], breaks[i].z)) {
-        e = xs[i];
-        zE = breaks[i].z;
-        continue;
+    const Stretch startStretch = stretchOf(t, start);
+    stretch = Stretch::arcB;
+    if (startStretch != Stretch::arcB) {
+      const Point2 lineEnd = t.linePoint(1.0);
+      if (!(lineEnd == inside)) {
+        if (!isBelowTop(k, lineEnd.x, lineEnd.z)) {
+          return crossingOnStretch(t, Stretch::arcB, k, lineEnd, inside);
+        }
+        inside = lineEnd;
       }
-      return crossingOnFeature(t, k, xs[i], e, zE);
+      stretch = Stretch::line;
+      if (startStretch == Stretch::arcA) {
+        const Point2 lineStart = t.linePoint(0.0);
+        if (!(lineStart == inside)) {
+          if (!isBelowTop(k, lineStart.x, lineStart.z)) {
+            return crossingOnStretch(t, Stretch::line, k, lineStart, inside);
+          }
+          inside = lineStart;
+        }
+        stretch = Stretch::arcA;
+      }
     }
   }
-  if (isBelowTop(k, lo, zLo)) return {lo, zLo};
-  return crossingOnFeature(t, k, lo, e, zE);
+  if (isBelowTop(k, start.x, start.z)) return start;
+  return crossingOnStretch(t, stretch, k, start, inside);
 }
 
 struct StackEntry {
@@ -347,6 +413,24 @@ struct StackEntry {
   double nz = 0.0;
   bool jump = false;  // the envelope jumps there (the ball slides along a vertical edge)
 };
+
+// Backward exclusion's test: does capsule K cover the whole piece of `top`, which starts at
+// (top.x, top.z) and ends at pieceEnd? By the ordering of contacts it does when it is on or
+// above that piece's start. At the start this is "the point is within r of K's edge" (no
+// square root). When the point is on K's boundary up to rounding (within `band`), the
+// distance cannot tell, and two circles touching at their extremes may still part by far
+// more than the rounding (one a little above the other): then compare heights a little to
+// the right, inside the piece, where the order that holds from there on shows.
+bool dominatesPiece(const Capsule& K, const StackEntry& top, std::span<const Point2> chain,
+                    double r, double band, double pieceEnd) {
+  const Point2 p{top.x, top.z};
+  if (withinRadius(p, K.a, K.b, r - band)) return true;
+  if (!withinRadius(p, K.a, K.b, r + band)) return false;
+  const Capsule T = capsuleWithNormal(chain[top.edge], chain[top.edge + 1], r, top.nx, top.nz);
+  const double x = top.x + 1e-6 * std::max(0.0, std::min(pieceEnd, T.right()) - top.x);
+  if (x < K.left() || x > K.right()) return false;
+  return K.top(x) >= T.top(x);
+}
 
 // Builds the tool path and the hull from the envelope: the stack lists the capsules that
 // form c(x), each from its start to the next one's start.
@@ -502,7 +586,7 @@ class OutputBuilder {
     for (std::size_t e = fromEdge; e <= toEdge && e + 1 < chain_.size(); ++e) {
       const Point2& a = chain_[e];
       const Point2& b = chain_[e + 1];
-      if (a.x != b.x || std::abs(a.x - wallX) > tau_) continue;
+      if (std::abs(b.x - a.x) > 0.1 * tau_ || std::abs(a.x - wallX) > tau_) continue;
       lastWall = e;
       const double target = clampToSlide(b.z);
       // The edge must hold the current height and lead on in the slide's direction.
@@ -546,26 +630,25 @@ class OutputBuilder {
       arcTo(endAt(to), c.a.z >= c.b.z ? edge : edge + 1);
       return;
     }
-    enum class Piece { arcA, line, arcB };
     double t1 = 1.0;  // where the piece stops on the line, if it stops there
-    Piece stop = Piece::arcB;
+    Stretch stop = Stretch::arcB;
     if (handOver) {
-      const double t = projectOnLine(c, *handOver);
-      stop = t <= 0.0 ? Piece::arcA : (t < 1.0 ? Piece::line : Piece::arcB);
-      t1 = std::clamp(t, 0.0, 1.0);
+      stop = stretchOf(c, *handOver);
+      t1 = std::clamp(projectOnLine(c, *handOver), 0.0, 1.0);
     } else if (to < c.s0) {
-      stop = Piece::arcA;
+      stop = Stretch::arcA;
     } else if (to < c.s1) {
-      stop = Piece::line;
+      stop = Stretch::line;
       t1 = c.lineParameter(to);
     }
-    const double t0raw = projectOnLine(c, end_);
-    const double t0 = std::clamp(t0raw, 0.0, 1.0);
-    if (t0raw <= 0.0 && from < c.s1) {
+    const Stretch begin = stretchOf(c, end_);
+    const double t0 = begin == Stretch::arcA ? 0.0 : std::clamp(projectOnLine(c, end_), 0.0, 1.0);
+    if (begin == Stretch::arcA) {
       // The arc around a ends where the offset line begins (its tangent point, exactly).
-      arcTo(stop == Piece::arcA ? endAt(to) : c.linePoint(0.0), edge);
+      arcTo(stop == Stretch::arcA ? endAt(to) : c.linePoint(0.0), edge);
     }
-    if (stop == Piece::arcA) return;
+    if (stop == Stretch::arcA) return;
+    if (stop == Stretch::line && begin == Stretch::arcB) return;  // rounding: nothing left
     if (t1 > t0 && t0 < 1.0) {
       auto onEdge = [&](double t) {
         if (t <= 0.0) return c.a;
@@ -573,10 +656,10 @@ class OutputBuilder {
         return Point2{c.a.x + t * (c.b.x - c.a.x), c.a.z + t * (c.b.z - c.a.z)};
       };
       Point2 pathEnd = c.linePoint(1.0);
-      if (stop == Piece::line) pathEnd = handOver ? *handOver : Point2{to, c.linePoint(t1).z};
+      if (stop == Stretch::line) pathEnd = handOver ? *handOver : Point2{to, c.linePoint(t1).z};
       lineTo(pathEnd, edge, onEdge(t0), onEdge(t1));
     }
-    if (stop == Piece::arcB) arcTo(endAt(to), edge + 1);
+    if (stop == Stretch::arcB) arcTo(endAt(to), edge + 1);
   }
 
   std::span<const Point2> chain_;
@@ -671,6 +754,10 @@ ScallopHull scallopHull(std::span<const Point2> chain, double radius) {
   const double r = radius;
   const double scale = std::max(r, coordinateScale(chain));
   const double tau = kRelativeTolerance * scale;
+  // Edges steeper than this run are vertical (a tenth of the tolerance; see makeCapsule).
+  const double verticalRun = 0.1 * tau;
+  // Distances are known to about this much (a few ulps of the coordinates and of r).
+  const double band = 64.0 * std::numeric_limits<double>::epsilon() * (scale + r);
 
   std::vector<StackEntry> stack;
   stack.reserve(std::min<std::size_t>(chain.size(), std::size_t{1} << 20));
@@ -680,19 +767,17 @@ ScallopHull scallopHull(std::span<const Point2> chain, double radius) {
     ++stats.pushes;
   };
   for (std::size_t k = 0; k + 1 < chain.size(); ++k) {
-    const Capsule K = makeCapsule(chain[k], chain[k + 1], r);
+    const Capsule K = makeCapsule(chain[k], chain[k + 1], r, verticalRun);
     // Backward exclusion: K covers the whole piece of the top capsule when it is on or above
     // it where that piece starts (contacts are ordered, so K stays above from there on).
     double poppedFrom = K.left();
     bool poppedJump = false;
+    const std::size_t entriesBeforePops = stack.size() + 1;
     while (!stack.empty()) {
       const StackEntry& top = stack.back();
       ++stats.comparisons;
-      // On the capsule's boundary (within rounding) the distance test cannot tell; there,
-      // as at the extremes of a circle, the height test can: ask it in that case only.
-      if (!withinRadius({top.x, top.z}, K.a, K.b, r) &&
-          (!withinRadius({top.x, top.z}, K.a, K.b, r * (1.0 + 1e-9)) ||
-           !isBelowTop(K, top.x, top.z))) {
+      if (!dominatesPiece(K, stack.back(), chain, r, band,
+                          stack.size() + 1 == entriesBeforePops ? K.right() : poppedFrom)) {
         break;
       }
       poppedFrom = top.x;
@@ -749,20 +834,23 @@ ScallopHull scallopHull(std::span<const Point2> chain, double radius) {
     const double zLo = lo == top.x ? top.z : T.top(lo);
     const Point2 handOver = crossing(T, K, lo, hi, zLo, T.upperEndAtRight().z);
     const double start = handOver.x;
-    // Taking over where a vertical K begins, K may start above T: the ball climbs the
-    // vertical edge. (A non-vertical K starts at the equator of the circle around K.a, and
-    // the capsule before it holds that circle: no jump.) Taking over where T began, T's
-    // piece is empty and K inherits its hand-over; likewise where a popped piece began.
-    const bool jump = (start == K.left() && K.vertical) || (start == top.x && top.jump) ||
-                      (start == poppedFrom && poppedJump);
+    // Taking over where K begins, K may start above T: the ball climbs a vertical edge (K's
+    // own, or one K has just covered). Taking over where T began, T's piece is empty and K
+    // inherits its hand-over; likewise where a popped piece began.
+    // (Equal up to rounding: the abscissae come from different sums.)
+    const double margin = xMargin(K, handOver);
+    const bool atLeftEnd = start <= K.left() + margin;
+    const double kStart = K.top(start);
+    const bool jump = (atLeftEnd && kStart > handOver.z + tau) ||
+                      (std::abs(start - top.x) <= margin && top.jump) ||
+                      (std::abs(start - poppedFrom) <= margin && poppedJump);
     // After a jump the piece starts at K's own height there; otherwise at the crossing
     // point, computed on the curves themselves (well conditioned on a near-vertical line).
-    push(k, start, jump ? K.top(start) : handOver.z, K, jump);
+    push(k, start, jump ? kStart : handOver.z, K, jump);
   }
 
   out.toolpath.reserve(2 * stack.size() + 4);
   out.hull.reserve(2 * stack.size() + 4);
-  if (std::getenv("SCALLOP_DEBUG")) for (auto& e : stack) std::fprintf(stderr, "entry edge %zu x %.17g z %.17g jump %d\n", e.edge, e.x, e.z, int(e.jump));
   OutputBuilder(chain, r, tau, out).build(stack);
   return out;
 }

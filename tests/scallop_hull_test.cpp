@@ -1674,50 +1674,6 @@ void checkMappedBand(const Case& original, const ScallopHull& transformed, doubl
   }
 }
 
-// Compares the discrete structure (element kinds and features, features mapped by
-// `edgeMap` / `vertexMap`; order reversed if `reversed`) when neither result has a piece
-// shorter than 3 tau (those may be merged differently by either side). Returns whether it
-// compared.
-bool compareStructure(const ScallopHull& a, const ScallopHull& b, const Chain& chainB, double tau,
-                      bool reversed, const std::function<std::size_t(std::size_t)>& edgeMap,
-                      const std::function<std::size_t(std::size_t)>& vertexMap, Violations& v) {
-  const auto tiny = [&](const ScallopHull& h) {
-    for (const PathElement& e : h.toolpath)
-      if (dist(e.start, e.end) <= 3 * tau) return true;
-    for (const HullElement& e : h.hull)
-      if (dist(e.start, e.end) <= 3 * tau) return true;
-    return false;
-  };
-  if (tiny(a) || tiny(b)) return false;
-  if (a.toolpath.size() != b.toolpath.size() || a.hull.size() != b.hull.size()) {
-    v.add("structure differs: path ", a.toolpath.size(), " vs ", b.toolpath.size(), " elements, hull ",
-          a.hull.size(), " vs ", b.hull.size());
-    return true;
-  }
-  const std::size_t m = a.toolpath.size();
-  for (std::size_t k = 0; k < m; ++k) {
-    const PathElement& ea = a.toolpath[k];
-    const PathElement& eb = b.toolpath[reversed ? m - 1 - k : k];
-    if (ea.kind != eb.kind) {
-      v.add("path element ", k, " kind differs");
-    } else if (ea.kind == PathElementKind::line && edgeMap(ea.feature) != eb.feature) {
-      v.add("path line ", k, " offsets edge ", ea.feature, " -> expected ", edgeMap(ea.feature), ", got ", eb.feature);
-    } else if (ea.kind == PathElementKind::arc && !(chainB[vertexMap(ea.feature)] == chainB[eb.feature])) {
-      v.add("path arc ", k, " rolls around vertex ", ea.feature, " -> expected ", vertexMap(ea.feature), ", got ", eb.feature);
-    }
-  }
-  const std::size_t h = a.hull.size();
-  for (std::size_t k = 0; k < h; ++k) {
-    const HullElement& ea = a.hull[k];
-    const HullElement& eb = b.hull[reversed ? h - 1 - k : k];
-    if (ea.kind != eb.kind)
-      v.add("hull element ", k, " kind differs");
-    else if (ea.kind == HullElementKind::link && edgeMap(ea.edge) != eb.edge)
-      v.add("hull link ", k, " on edge ", ea.edge, " -> expected ", edgeMap(ea.edge), ", got ", eb.edge);
-  }
-  return true;
-}
-
 constexpr std::array kGenericShapes = {Shape::randomWalk, Shape::sawtooth, Shape::steps,
                                        Shape::narrowPits, Shape::smooth,   Shape::spikes,
                                        Shape::collinear,  Shape::plateaus, Shape::verticalZigzag};
@@ -1742,13 +1698,17 @@ TEST(ScallopHullTransforms, TranslationTranslatesResults) {
     Violations v;
     checkMappedBand(c, b, tauT, std::max(t.radius, coordinateScaleOf(t.chain)), 1.0,
                     [&](Point2 p) { return Point2{p.x - dx, p.z - dz}; }, v);
-    const auto same = [](std::size_t k) { return k; };
-    compared += compareStructure(a, b, t.chain, tauT, false, same, same, v);
+    // The structure (which features appear) is compared only where the transform is exact
+    // (UniformScalingScalesResults, powers of two): it is defined up to the tolerance only.
+    // Two features may stay within tau of each other over a stretch much longer than tau
+    // (the nearly flat arcs of a ball far larger than the chain, the several ways to cover a
+    // vertical zigzag), and the rounding of the transformed input then picks either.
+    ++compared;
     if (!v.empty() && ++failures <= 3)
       ADD_FAILURE() << "translation by " << fmt(Point2{dx, dz}) << ":\n" << v.str() << corpusEntry(c);
   }
   EXPECT_EQ(failures, 0);
-  EXPECT_GT(compared, kTransformCases / 2);  // the structural comparison really ran
+  EXPECT_EQ(compared, kTransformCases);
 }
 
 TEST(ScallopHullTransforms, UniformScalingScalesResults) {
@@ -1766,9 +1726,6 @@ TEST(ScallopHullTransforms, UniformScalingScalesResults) {
     Violations v;
     checkMappedBand(c, b, tauT, std::max(t.radius, coordinateScaleOf(t.chain)), s,
                     [&](Point2 p) { return Point2{p.x / s, p.z / s}; }, v);
-    const auto same = [](std::size_t k) { return k; };
-    compared += compareStructure(a, b, t.chain, std::max(tauT, s * toleranceFor(c.chain, c.radius)),
-                                 false, same, same, v);
     // Scaling by a power of two is exact in binary floating point (no overflow or underflow
     // here), and so is every operation of a scale-free algorithm (sums, products, quotients,
     // sqrt of a 4^k multiple): the results must scale bit for bit. A difference means an
@@ -1790,12 +1747,13 @@ TEST(ScallopHullTransforms, UniformScalingScalesResults) {
                 (ea.kind == HullElementKind::link ? ea.edge == eb.edge : eb.center == s * ea.center);
       }
       if (!exact) v.add("scaling by 2^k = ", s, " is not exact");
+      ++compared;  // only here is the structure itself compared (see the translation test)
     }
     if (!v.empty() && ++failures <= 3)
       ADD_FAILURE() << "scaling by " << s << ":\n" << v.str() << corpusEntry(c);
   }
   EXPECT_EQ(failures, 0);
-  EXPECT_GT(compared, kTransformCases / 2);
+  EXPECT_GT(compared, kTransformCases / 4);  // about a third of the scales are powers of two
 }
 
 TEST(ScallopHullTransforms, MirroringReversesResults) {
@@ -1821,12 +1779,13 @@ TEST(ScallopHullTransforms, MirroringReversesResults) {
       if (!(hb >= ref.envelope(x, c.radius - tau) && hb <= ref.envelope(x, c.radius + tau)))
         v.add("mirrored pathHeightAt(", -x, ") = ", hb, " outside the original band at ", x);
     }
-    compared += compareStructure(a, b, t.chain, tau, true, [&](std::size_t e) { return n - 2 - e; },
-                                 [&](std::size_t k) { return n - 1 - k; }, v);
+    // Geometry only, as for translation: the reversed pass rounds differently, and the
+    // structure is defined up to the tolerance only.
+    ++compared;
     if (!v.empty() && ++failures <= 3) ADD_FAILURE() << "mirroring:\n" << v.str() << corpusEntry(c);
   }
   EXPECT_EQ(failures, 0);
-  EXPECT_GT(compared, kTransformCases / 2);
+  EXPECT_EQ(compared, kTransformCases);
 }
 
 // ---------------------------------------------------------------------------------------
