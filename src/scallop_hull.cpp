@@ -105,36 +105,49 @@ Capsule makeCapsule(const Point2& a, const Point2& b, double r, double verticalR
   return capsuleWithNormal(a, b, r, -dz / length, dx / length);
 }
 
-// True when p is within distance r of the segment a-b, i.e. inside the capsule. For a point
-// on the current envelope (the start of a stacked piece) this is the same as "the capsule's
-// top is on or above p": the envelope lies above the arc around a = v_k, and so above the
-// capsule's lower boundary. It needs neither a square root nor a division. (Points of a
-// stacked capsule beyond its piece are not on the envelope: for those use isBelowTop.)
-// |(u, w)|^2 - r^2 >= 0 up to rounding, written as (|u| - r)(|u| + r) + w^2 with |u| the
-// larger component: no cancellation when a point lies near the extreme of a circle (one
-// component ~ r), where the plain difference of squares loses all precision once r is
-// large.
-bool outsideCircle(double u, double w, double r) {
+// |(u, w)|^2 - r^2, written as (|u| - r)(|u| + r) + w^2 with |u| the larger component: no
+// cancellation when a point lies near the extreme of a circle (one component ~ r), where
+// the plain difference of squares loses all precision once r is large.
+double circleExcess(double u, double w, double r) {
   u = std::abs(u);
   w = std::abs(w);
   if (u < w) std::swap(u, w);
-  return (u - r) * (u + r) + w * w > 0.0;
+  return (u - r) * (u + r) + w * w;
 }
 
-bool withinRadius(const Point2& p, const Point2& a, const Point2& b, double r) {
+
+// Which side of the boundary of capsule a-b (radius r) point p is on, with an undecided
+// band of half-width `band` around it: -1 inside (distance <= r - band), +1 outside
+// (distance >= r + band), 0 too close to tell. One evaluation, no square root. For a point
+// on the current envelope (the start of a stacked piece) "inside" is the same as "the
+// capsule's top is on or above p": the envelope lies above the arc around a = v_k, and so
+// above the capsule's lower boundary. (Points of a stacked capsule beyond its piece are
+// not on the envelope: for those use isBelowTop.)
+int sideOfCapsule(const Point2& p, const Point2& a, const Point2& b, double r, double band) {
   const double dx = b.x - a.x;
   const double dz = b.z - a.z;
   const double px = p.x - a.x;
   const double pz = p.z - a.z;
   const double dot = px * dx + pz * dz;
-  if (dot <= 0.0) return !outsideCircle(px, pz, r);
   const double length2 = dx * dx + dz * dz;
-  if (dot >= length2) return !outsideCircle(p.x - b.x, p.z - b.z, r);
-  // Distance to the line: |cross| / length <= r (squared: both sides carry the same
-  // relative rounding, so the decision is as accurate as the distance itself).
-  const double cross = px * dz - pz * dx;
-  return cross * cross <= (r * r) * length2;
+  double excess;  // distance^2 - r^2, times length2 for the line case
+  double scale = 1.0;
+  if (dot <= 0.0 || length2 == 0.0) {
+    excess = circleExcess(px, pz, r);
+  } else if (dot >= length2) {
+    excess = circleExcess(p.x - b.x, p.z - b.z, r);
+  } else {
+    const double cross = px * dz - pz * dx;
+    excess = cross * cross - (r * r) * length2;
+    scale = length2;
+  }
+  // distance - r ~ (distance^2 - r^2) / 2r.
+  const double threshold = 2.0 * r * band * scale;
+  if (excess <= -threshold) return -1;
+  if (excess >= threshold) return 1;
+  return 0;
 }
+
 
 // Parameter of the foot of p on the offset line of c (0 above a, 1 above b), not clamped:
 // points of the arc around a project below 0 and those of the arc around b above 1. Well
@@ -405,6 +418,53 @@ Point2 crossing(const Capsule& t, const Capsule& k, double lo, double hi, double
   return crossingOnStretch(t, stretch, k, start, inside);
 }
 
+// The usual hand-overs in closed form: the meeting point of one stretch of T with one of K
+// (peak-peak, peak-slope, slope-peak, slope-slope). A meeting point is accepted only if it lies on both stretches,
+// strictly inside T's piece (lo, hi), away from near-vertical lines, and K rises through T
+// there (the clockwise tangent of K turns up from T's); by the ordering of contacts K - T
+// changes sign once on T's piece, so such a point is the crossing. Otherwise: nothing, and
+// `crossing` decides.
+std::optional<Point2> quickCrossing(const Capsule& t, const Capsule& k, double lo, double hi) {
+  if (t.vertical || k.vertical) return std::nullopt;
+  constexpr double kMaxSlope = 1e6;  // steeper lines: x no longer places points well
+  const bool tLineOk = std::abs(t.b.z - t.a.z) <= kMaxSlope * (t.b.x - t.a.x);
+  const bool kLineOk = std::abs(k.b.z - k.a.z) <= kMaxSlope * (k.b.x - k.a.x);
+  auto tangent = [](const Capsule& c, const Feature& f, const Point2& q) {
+    if (!f.isArc) return Point2{c.b.x - c.a.x, c.b.z - c.a.z};
+    return Point2{q.z - f.point.z, f.point.x - q.x};  // clockwise along the upper arc
+  };
+  // In order of frequency on random walks: a peak of T (its start a: the arc around a
+  // vertex belongs to the later of its two edges) meets a peak of K, then slopes.
+  constexpr std::array<std::pair<Stretch, Stretch>, 6> kPairs{{{Stretch::arcA, Stretch::arcB},
+                                                               {Stretch::arcA, Stretch::arcA},
+                                                               {Stretch::line, Stretch::arcB},
+                                                               {Stretch::line, Stretch::arcA},
+                                                               {Stretch::arcA, Stretch::line},
+                                                               {Stretch::line, Stretch::line}}};
+  for (const auto& [ts, ks] : kPairs) {
+    if ((ts == Stretch::line && !tLineOk) || (ks == Stretch::line && !kLineOk)) continue;
+    const Feature f = featureOf(t, ts);
+    const Feature g = featureOf(k, ks);
+    if (f.isArc && g.isArc && f.point == g.point) continue;
+    std::array<Point2, 2> roots{};
+    const int n = featureRoots(f, g, t.r, roots);
+    for (int i = 0; i < n; ++i) {
+      const Point2& q = roots[i];
+      const double margin = xMargin(t, q) + 1e-9 * (hi - lo);
+      if (!(q.x > lo + margin && q.x < hi - margin)) continue;
+      if (stretchOf(t, q) != ts || stretchOf(k, q) != ks) continue;
+      const Point2 u = tangent(t, f, q);
+      const Point2 w = tangent(k, g, q);
+      // turn > 1e-9 |u| |w|, squared (no square roots).
+      const double turn = u.x * w.z - u.z * w.x;
+      if (turn > 0.0 && turn * turn > 1e-18 * (u.x * u.x + u.z * u.z) * (w.x * w.x + w.z * w.z)) {
+        return q;
+      }
+    }
+  }
+  return std::nullopt;
+}
+
 struct StackEntry {
   std::size_t edge = 0;
   double x = 0.0;   // where this edge's capsule takes over the envelope
@@ -423,9 +483,8 @@ struct StackEntry {
 // the right, inside the piece, where the order that holds from there on shows.
 bool dominatesPiece(const Capsule& K, const StackEntry& top, std::span<const Point2> chain,
                     double r, double band, double pieceEnd) {
-  const Point2 p{top.x, top.z};
-  if (withinRadius(p, K.a, K.b, r - band)) return true;
-  if (!withinRadius(p, K.a, K.b, r + band)) return false;
+  const int side = sideOfCapsule({top.x, top.z}, K.a, K.b, r, band);
+  if (side != 0) return side < 0;
   const Capsule T = capsuleWithNormal(chain[top.edge], chain[top.edge + 1], r, top.nx, top.nz);
   const double x = top.x + 1e-6 * std::max(0.0, std::min(pieceEnd, T.right()) - top.x);
   if (x < K.left() || x > K.right()) return false;
@@ -831,22 +890,22 @@ ScallopHull scallopHull(std::span<const Point2> chain, double radius) {
       if (K.right() > hi) push(k, hi, K.top(hi), K, true);
       continue;
     }
-    const double zLo = lo == top.x ? top.z : T.top(lo);
-    const Point2 handOver = crossing(T, K, lo, hi, zLo, T.upperEndAtRight().z);
+    const std::optional<Point2> quick = quickCrossing(T, K, lo, hi);
+    const Point2 handOver =
+        quick ? *quick
+              : crossing(T, K, lo, hi, lo == top.x ? top.z : T.top(lo), T.upperEndAtRight().z);
     const double start = handOver.x;
     // Taking over where K begins, K may start above T: the ball climbs a vertical edge (K's
     // own, or one K has just covered). Taking over where T began, T's piece is empty and K
     // inherits its hand-over; likewise where a popped piece began.
     // (Equal up to rounding: the abscissae come from different sums.)
     const double margin = xMargin(K, handOver);
-    const bool atLeftEnd = start <= K.left() + margin;
-    const double kStart = K.top(start);
-    const bool jump = (atLeftEnd && kStart > handOver.z + tau) ||
+    const bool jump = (start <= K.left() + margin && K.top(start) > handOver.z + tau) ||
                       (std::abs(start - top.x) <= margin && top.jump) ||
                       (std::abs(start - poppedFrom) <= margin && poppedJump);
     // After a jump the piece starts at K's own height there; otherwise at the crossing
     // point, computed on the curves themselves (well conditioned on a near-vertical line).
-    push(k, start, jump ? kStart : handOver.z, K, jump);
+    push(k, start, jump ? K.top(start) : handOver.z, K, jump);
   }
 
   out.toolpath.reserve(2 * stack.size() + 4);
