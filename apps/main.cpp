@@ -13,8 +13,7 @@
 #include "commands.hpp"
 
 #ifndef SCALLOP_VERSION
-// Keep in step with project(VERSION ...) in the top-level CMakeLists.txt.
-#define SCALLOP_VERSION "0.1.0"
+#error "SCALLOP_VERSION is set by apps/CMakeLists.txt from project(VERSION ...)"
 #endif
 
 namespace {
