@@ -13,8 +13,8 @@ build="${BUILD_DIR:-$root/build}"
 jobs="${JOBS:-$(nproc)}"
 
 # Debian packages scallop builds with (headers, CMake configs, test and bench frameworks).
-packages=(build-essential cmake nlohmann-json3-dev libfmt-dev libcli11-dev libgtest-dev
-          libgmock-dev libbenchmark-dev)
+packages=(build-essential cmake nlohmann-json3-dev libfmt-dev libcli11-dev libboost-dev
+          libgtest-dev libgmock-dev libbenchmark-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
