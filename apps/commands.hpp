@@ -12,4 +12,7 @@ namespace scallop::cli {
 /// `scallop hull`: the scallop hull of a chain and its tool-centre path, as JSON and/or SVG.
 void addHullCommand(CLI::App& app);
 
+/// `scallop orient`: the optimal slicing orientation of a surface, as JSON and/or SVG figures.
+void addOrientCommand(CLI::App& app);
+
 }  // namespace scallop::cli

@@ -5,18 +5,16 @@
 
 #include <algorithm>
 #include <cctype>
-#include <charconv>
 #include <chrono>
-#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <string>
-#include <system_error>
 #include <vector>
 
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
+#include "arguments.hpp"
 #include "commands.hpp"
 #include "scallop/chain_io.hpp"
 #include "scallop/error.hpp"
@@ -44,35 +42,6 @@ std::string lowercase(std::string text) {
   std::transform(text.begin(), text.end(), text.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return text;
-}
-
-// A positive finite number: the whole of `text` (std::from_chars: locale-independent, no
-// blanks, no trailing characters; one leading '+' allowed), or scallop::Error naming `what`
-// and the text.
-double parsePositive(const std::string& text, const char* what, const char* expected) {
-  std::string_view digits = text;
-  if (digits.size() > 1 && digits.front() == '+' && digits[1] != '-' && digits[1] != '+') {
-    digits.remove_prefix(1);
-  }
-  double value = 0.0;
-  const char* end = digits.data() + digits.size();
-  const auto [stop, error] = std::from_chars(digits.data(), end, value);
-  if (digits.empty() || stop != end || error == std::errc::invalid_argument) {
-    throw Error(fmt::format("invalid {} '{}': expected {}", what, text, expected));
-  }
-  if (error == std::errc::result_out_of_range) {
-    throw Error(fmt::format("invalid {} '{}': out of the range of a double", what, text));
-  }
-  if (std::isnan(value)) {
-    throw Error(fmt::format("invalid {} '{}': not a number; expected {}", what, text, expected));
-  }
-  if (!(value > 0.0)) {
-    throw Error(fmt::format("invalid {} '{}': must be positive", what, text));
-  }
-  if (std::isinf(value)) {
-    throw Error(fmt::format("invalid {} '{}': expected {}", what, text, expected));
-  }
-  return value;
 }
 
 // r > 0, or "inf"/"infinity" for the r = infinity limit (the upper convex hull).

@@ -1,0 +1,234 @@
+// Tensor-product Bezier patches: evaluation by differencing and de Casteljau, normals,
+// subdivision, and the Bernstein-form polynomials of the normal and the Gaussian curvature.
+// See include/scallop/bezier.hpp for the contract.
+
+#include "scallop/bezier.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <fmt/format.h>
+
+#include "scallop/error.hpp"
+
+namespace scallop {
+namespace {
+
+constexpr double kUnitRoundoff = std::numeric_limits<double>::epsilon() / 2;  // u = 2^-53
+
+void requireValid(const BezierPatch& patch, const char* what) {
+  if (patch.degreeU < 1 || patch.degreeV < 1) {
+    throw Error(fmt::format("{}: a Bezier patch needs degrees >= 1, got ({}, {})", what,
+                            patch.degreeU, patch.degreeV));
+  }
+  const std::size_t expected =
+      static_cast<std::size_t>(patch.degreeU + 1) * static_cast<std::size_t>(patch.degreeV + 1);
+  if (patch.control.size() != expected) {
+    throw Error(fmt::format("{}: bidegree ({}, {}) needs {} control points, got {}", what,
+                            patch.degreeU, patch.degreeV, expected, patch.control.size()));
+  }
+}
+
+// In-place de Casteljau on b[0 .. n]; returns the point at t.
+Vec3 deCasteljau(Vec3* b, int n, double t) {
+  const double s = 1.0 - t;
+  for (int r = 1; r <= n; ++r) {
+    for (int i = 0; i <= n - r; ++i) b[i] = s * b[i] + t * b[i + 1];
+  }
+  return b[0];
+}
+
+// n (n - 1) .. (n - d + 1)
+double fallingFactorial(int n, int d) {
+  double f = 1.0;
+  for (int i = 0; i < d; ++i) f *= n - i;
+  return f;
+}
+
+// The (du, dv) partial derivative at (u, v): difference the control net dv times along v
+// and du times along u, evaluate each row in v and the resulting column in u (de Casteljau),
+// and multiply by m!/(m-du)! n!/(n-dv)!. Differencing first keeps the derivative's rounding
+// relative to the differences, not to the coordinates.
+Vec3 partial(const BezierPatch& patch, double u, double v, int du, int dv) {
+  const int m = patch.degreeU;
+  const int n = patch.degreeV;
+  if (du > m || dv > n) return {};
+  const int stride = n + 1;
+  constexpr std::size_t kSmall = 36;  // up to bidegree (5, 5) without allocation
+  std::array<Vec3, kSmall> small{};
+  std::vector<Vec3> large;
+  Vec3* net = small.data();
+  if (patch.control.size() > kSmall) {
+    large.resize(patch.control.size());
+    net = large.data();
+  }
+  std::copy(patch.control.begin(), patch.control.end(), net);
+  for (int j = 0; j <= m; ++j) {
+    Vec3* row = net + j * stride;
+    for (int d = 1; d <= dv; ++d) {
+      for (int k = 0; k <= n - d; ++k) row[k] = row[k + 1] - row[k];
+    }
+  }
+  for (int d = 1; d <= du; ++d) {
+    for (int j = 0; j <= m - d; ++j) {
+      for (int k = 0; k <= n - dv; ++k)
+        net[j * stride + k] = net[(j + 1) * stride + k] - net[j * stride + k];
+    }
+  }
+  // Row j's value lands in net[j * stride]; gathering it into net[j] only overwrites entries
+  // already used (net[j] lies in row 0, or is the source of an earlier row j / stride).
+  for (int j = 0; j <= m - du; ++j) net[j] = deCasteljau(net + j * stride, n - dv, v);
+  return (fallingFactorial(m, du) * fallingFactorial(n, dv)) * deCasteljau(net, m - du, u);
+}
+
+BezierPatch fromCoordinates(const std::array<Bernstein2, 3>& xyz) {
+  BezierPatch patch{xyz[0].degreeU, xyz[0].degreeV, std::vector<Vec3>(xyz[0].coefficients.size())};
+  for (std::size_t i = 0; i < patch.control.size(); ++i) {
+    patch.control[i] = {xyz[0].coefficients[i], xyz[1].coefficients[i], xyz[2].coefficients[i]};
+  }
+  return patch;
+}
+
+template <class F>
+BezierPatch mapCoordinates(const BezierPatch& patch, F f) {
+  const std::array<Bernstein2, 3> xyz = coordinatePolynomials(patch);
+  return fromCoordinates({f(xyz[0]), f(xyz[1]), f(xyz[2])});
+}
+
+Bernstein2 dot(const std::array<Bernstein2, 3>& a, const std::array<Bernstein2, 3>& b) {
+  return add(add(multiply(a[0], b[0]), multiply(a[1], b[1])), multiply(a[2], b[2]));
+}
+
+std::array<Bernstein2, 3> derivativesU(const std::array<Bernstein2, 3>& r) {
+  return {derivativeU(r[0]), derivativeU(r[1]), derivativeU(r[2])};
+}
+
+std::array<Bernstein2, 3> derivativesV(const std::array<Bernstein2, 3>& r) {
+  return {derivativeV(r[0]), derivativeV(r[1]), derivativeV(r[2])};
+}
+
+}  // namespace
+
+Vec3 point(const BezierPatch& patch, double u, double v) {
+  requireValid(patch, "point");
+  return partial(patch, u, v, 0, 0);
+}
+
+Vec3 derivativeU(const BezierPatch& patch, double u, double v) {
+  requireValid(patch, "derivativeU");
+  return partial(patch, u, v, 1, 0);
+}
+
+Vec3 derivativeV(const BezierPatch& patch, double u, double v) {
+  requireValid(patch, "derivativeV");
+  return partial(patch, u, v, 0, 1);
+}
+
+Vec3 secondDerivative(const BezierPatch& patch, double u, double v, int du, int dv) {
+  requireValid(patch, "secondDerivative");
+  if (du < 0 || dv < 0 || du + dv != 2) {
+    throw Error(fmt::format(
+        "secondDerivative: orders (du, dv) must be (2, 0), (1, 1) or (0, 2), got ({}, {})", du,
+        dv));
+  }
+  return partial(patch, u, v, du, dv);
+}
+
+Vec3 normalVector(const BezierPatch& patch, double u, double v) {
+  requireValid(patch, "normalVector");
+  return cross(partial(patch, u, v, 1, 0), partial(patch, u, v, 0, 1));
+}
+
+Vec3 unitNormal(const BezierPatch& patch, double u, double v) {
+  requireValid(patch, "unitNormal");
+  const int m = patch.degreeU;
+  const int n = patch.degreeV;
+  const Vec3 normal = cross(partial(patch, u, v, 1, 0), partial(patch, u, v, 0, 1));
+  // S_u = m max|p_{j+1,k} - p_jk| >= |r_u| and likewise S_v >= |r_v| on the patch (m times a
+  // convex combination of the differences). The computed r_u is within
+  // gamma_{3(m+n)+2} S_u of the exact one (differences, de Casteljau, the degree factor),
+  // likewise r_v, and the cross product adds 3u |r_u||r_v|: below (6(m + n) + 8) u S_u S_v
+  // the computed normal may be rounding noise, and its direction meaningless.
+  double su = 0.0;
+  double sv = 0.0;
+  for (int j = 0; j <= m; ++j) {
+    for (int k = 0; k <= n; ++k) {
+      if (j < m) su = std::max(su, norm(patch.at(j + 1, k) - patch.at(j, k)));
+      if (k < n) sv = std::max(sv, norm(patch.at(j, k + 1) - patch.at(j, k)));
+    }
+  }
+  const double length = norm(normal);
+  const double threshold = (6.0 * (m + n) + 8.0) * kUnitRoundoff * (m * su) * (n * sv);
+  if (!(length > threshold)) {
+    throw Error(fmt::format(
+        "unitNormal: r_u x r_v vanishes at (u, v) = ({}, {}); the patch is not regular there", u,
+        v));
+  }
+  return normal / length;
+}
+
+std::pair<BezierPatch, BezierPatch> subdivideU(const BezierPatch& patch, double t) {
+  requireValid(patch, "subdivideU");
+  return {mapCoordinates(patch, [t](const Bernstein2& c) { return subdivideU(c, t).first; }),
+          mapCoordinates(patch, [t](const Bernstein2& c) { return subdivideU(c, t).second; })};
+}
+
+std::pair<BezierPatch, BezierPatch> subdivideV(const BezierPatch& patch, double t) {
+  requireValid(patch, "subdivideV");
+  return {mapCoordinates(patch, [t](const Bernstein2& c) { return subdivideV(c, t).first; }),
+          mapCoordinates(patch, [t](const Bernstein2& c) { return subdivideV(c, t).second; })};
+}
+
+BezierPatch restrictTo(const BezierPatch& patch, double u0, double u1, double v0, double v1) {
+  requireValid(patch, "restrictTo");
+  return mapCoordinates(patch, [&](const Bernstein2& c) { return restrictTo(c, u0, u1, v0, v1); });
+}
+
+std::array<Bernstein2, 3> coordinatePolynomials(const BezierPatch& patch) {
+  requireValid(patch, "coordinatePolynomials");
+  std::array<Bernstein2, 3> xyz;
+  for (Bernstein2& c : xyz) {
+    c.degreeU = patch.degreeU;
+    c.degreeV = patch.degreeV;
+    c.coefficients.resize(patch.control.size());
+  }
+  for (std::size_t i = 0; i < patch.control.size(); ++i) {
+    xyz[0].coefficients[i] = patch.control[i].x;
+    xyz[1].coefficients[i] = patch.control[i].y;
+    xyz[2].coefficients[i] = patch.control[i].z;
+  }
+  return xyz;
+}
+
+std::array<Bernstein2, 3> normalPolynomials(const BezierPatch& patch) {
+  const std::array<Bernstein2, 3> r = coordinatePolynomials(patch);
+  const std::array<Bernstein2, 3> ru = derivativesU(r);  // (m - 1, n)
+  const std::array<Bernstein2, 3> rv = derivativesV(r);  // (m, n - 1)
+  return {subtract(multiply(ru[1], rv[2]), multiply(ru[2], rv[1])),
+          subtract(multiply(ru[2], rv[0]), multiply(ru[0], rv[2])),
+          subtract(multiply(ru[0], rv[1]), multiply(ru[1], rv[0]))};
+}
+
+Bernstein2 gaussianCurvatureNumerator(const BezierPatch& patch) {
+  const std::array<Bernstein2, 3> r = coordinatePolynomials(patch);
+  const std::array<Bernstein2, 3> normal = normalPolynomials(patch);  // (2m - 1, 2n - 1)
+  const std::array<Bernstein2, 3> ru = derivativesU(r);
+  const std::array<Bernstein2, 3> ruv = derivativesV(ru);  // (m - 1, n - 1)
+  const Bernstein2 mixed = dot(ruv, normal);               // (3m - 2, 3n - 2)
+  const Bernstein2 mixedSquared = multiply(mixed, mixed);  // (6m - 4, 6n - 4)
+  // r_uu (m - 2, n) and r_vv (m, n - 2) vanish identically for m = 1 or n = 1; leaving the
+  // product out then keeps the bidegree (6m - 4, 6n - 4) instead of padding it.
+  if (patch.degreeU < 2 || patch.degreeV < 2) return scale(mixedSquared, -1.0);
+  const Bernstein2 uu = dot(derivativesU(ru), normal);               // (3m - 3, 3n - 1)
+  const Bernstein2 vv = dot(derivativesV(derivativesV(r)), normal);  // (3m - 1, 3n - 3)
+  return subtract(multiply(uu, vv), mixedSquared);                   // (6m - 4, 6n - 4)
+}
+
+Bernstein2 normalLengthSquared(const BezierPatch& patch) {
+  const std::array<Bernstein2, 3> normal = normalPolynomials(patch);
+  return dot(normal, normal);
+}
+
+}  // namespace scallop

@@ -95,6 +95,24 @@ void writeStandardOutput(std::string_view content) {
   }
 }
 
+// An existing target that is not a regular file (a device such as /dev/null, a FIFO, a
+// terminal) cannot be replaced by renaming: renaming over it would turn /dev/null into a
+// plain file. Such a target is written directly, last, like standard output.
+bool isStreamTarget(const std::string& path) {
+  std::error_code error;
+  const std::filesystem::file_status status = std::filesystem::status(path, error);
+  return !error && std::filesystem::exists(status) && !std::filesystem::is_regular_file(status) &&
+         !std::filesystem::is_directory(status);
+}
+
+void writeStream(const std::string& path, std::string_view content) {
+  std::FILE* file = std::fopen(path.c_str(), "wb");
+  if (file == nullptr) throwWriteError(path, errnoReason(errno));
+  const bool ok = (content.empty() || std::fwrite(content.data(), 1, content.size(), file) == content.size());
+  const int saved = errno;
+  if (std::fclose(file) != 0 || !ok) throwWriteError(path, errnoReason(saved != 0 ? saved : EIO));
+}
+
 // Whether two paths name the same file, as far as can be told without the file existing
 // ("out.json" and "./out.json" do; symbolic links are not followed).
 bool sameLocation(const std::string& a, const std::string& b) {
@@ -113,6 +131,10 @@ void writeFileAtomically(const std::string& path, std::string_view content) {
   }
   if (path == kStandardOutput) {
     writeStandardOutput(content);
+    return;
+  }
+  if (isStreamTarget(path)) {
+    writeStream(path, content);
     return;
   }
   renameOver(writeTemporary(path, content), path);
@@ -135,8 +157,12 @@ void writeFilesAtomically(std::span<const OutputFile> files) {
   // Phase 1: every file's content into its temporary. Nothing visible has changed yet, so
   // a failure only has to remove the temporaries written so far.
   std::vector<std::string> temporaries(files.size());
+  std::vector<bool> stream(files.size());
   for (std::size_t i = 0; i < files.size(); ++i) {
-    if (files[i].path == kStandardOutput) {
+    stream[i] = files[i].path == kStandardOutput || isStreamTarget(files[i].path);
+  }
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    if (stream[i]) {
       continue;
     }
     try {
@@ -155,13 +181,18 @@ void writeFilesAtomically(std::span<const OutputFile> files) {
   std::vector<std::string> committed;
   try {
     for (std::size_t i = 0; i < files.size(); ++i) {
-      if (files[i].path == kStandardOutput) continue;
+      if (stream[i]) continue;
       const std::string temporary = std::exchange(temporaries[i], std::string());
       renameOver(temporary, files[i].path);
       committed.push_back(files[i].path);
     }
-    for (const OutputFile& file : files) {
-      if (file.path == kStandardOutput) writeStandardOutput(file.content);
+    for (std::size_t i = 0; i < files.size(); ++i) {
+      if (!stream[i]) continue;
+      if (files[i].path == kStandardOutput) {
+        writeStandardOutput(files[i].content);
+      } else {
+        writeStream(files[i].path, files[i].content);
+      }
     }
   } catch (...) {
     for (const std::string& temporary : temporaries) {

@@ -10,9 +10,14 @@
 #include <fmt/format.h>
 
 #include "scallop/error.hpp"
+#include "svg_format.hpp"
 
 namespace scallop {
 namespace {
+
+using svg::lengthLabel;
+using svg::px;
+using svg::roundLength;
 
 // Page layout, in SVG pixels.
 constexpr double kMaxPlotWidth = 960.0;
@@ -36,31 +41,6 @@ constexpr const char* kPathColour = "#2ca02c";
 constexpr const char* kToolColour = "#9467bd";
 
 constexpr double kPi = std::numbers::pi;
-
-// ---------------------------------------------------------------------------------------
-// Numbers
-// ---------------------------------------------------------------------------------------
-
-// Every coordinate in the file is in page pixels (bounded by the page size), so a fixed
-// three decimals is finer than any screen or printer and never needs an exponent.
-std::string px(double value) {
-  const std::string text = fmt::format("{:.3f}", value);
-  return text == "-0.000" ? std::string("0.000") : text;
-}
-
-// A length for a label, in the chain's unit: six significant digits, fixed notation (no
-// exponent however large or small), trailing zeros dropped.
-std::string lengthLabel(double value) {
-  if (value == 0.0) return "0";
-  const int magnitude = static_cast<int>(std::floor(std::log10(std::abs(value))));
-  const int decimals = std::clamp(5 - magnitude, 0, 340);
-  std::string text = fmt::format("{:.{}f}", value, decimals);
-  if (text.find('.') != std::string::npos) {
-    text.erase(text.find_last_not_of('0') + 1);
-    if (text.back() == '.') text.pop_back();
-  }
-  return text;
-}
 
 // ---------------------------------------------------------------------------------------
 // Geometry of the drawing
@@ -310,15 +290,6 @@ std::string titleText(std::span<const Point2> chain, const ScallopHull& result) 
   return fmt::format("Scallop hull: n = {} vertices, r = {} ({} links, {} lids{})", chain.size(),
                      finite ? lengthLabel(result.radius) : std::string("\u221e"), links, lids,
                      finite ? "" : "; upper convex hull, no tool path");
-}
-
-// The largest length of the form {1, 2, 5} x 10^k not longer than `limit`.
-double roundLength(double limit) {
-  const double power = std::pow(10.0, std::floor(std::log10(limit)));
-  for (const double step : {5.0, 2.0, 1.0}) {
-    if (step * power <= limit) return step * power;
-  }
-  return power;
 }
 
 std::string scaleBar(const View& view) {

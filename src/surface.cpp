@@ -1,0 +1,674 @@
+#include "scallop/surface.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "scallop/bernstein.hpp"
+#include "scallop/error.hpp"
+
+namespace scallop {
+namespace {
+
+using Json = nlohmann::json;
+
+// ---------------------------------------------------------------------------------------
+// Messages
+// ---------------------------------------------------------------------------------------
+
+constexpr std::size_t kMaxQuotedLength = 60;
+
+// Error messages quote the offending JSON value; a huge one is cut.
+std::string quoted(const Json& value) {
+  std::string text = value.dump();
+  if (text.size() > kMaxQuotedLength) text = text.substr(0, kMaxQuotedLength) + "...";
+  return text;
+}
+
+std::string displayName(const std::string& sourceName) {
+  return sourceName == "-" ? std::string("<stdin>") : sourceName;
+}
+
+// nlohmann's messages start with "[json.exception.parse_error.101] "; the rest (line,
+// column, what was expected) is what a user needs.
+std::string withoutExceptionId(const std::string& message) {
+  if (!message.empty() && message.front() == '[') {
+    const std::size_t close = message.find("] ");
+    if (close != std::string::npos) return message.substr(close + 2);
+  }
+  return message;
+}
+
+// "patches[1]", "patches[1].degree", "patches[1].control_points[2][0]".
+std::string patchPath(std::size_t patch) { return fmt::format("patches[{}]", patch); }
+
+// Shortest decimal that reads back as the same double (std::to_chars, correctly rounded
+// both ways), as "%g"-like text. A negative zero is written "-0.0": "-0" would be read as
+// the integer 0 by JSON parsers and lose its sign.
+std::string shortest(double value) {
+  std::array<char, 64> buffer{};
+  const auto result = std::to_chars(buffer.data(), buffer.data() + buffer.size(), value);
+  std::string text(buffer.data(), result.ptr);
+  if (text == "-0") text = "-0.0";
+  return text;
+}
+
+// ---------------------------------------------------------------------------------------
+// Regularity: f = |r_u x r_v|^2 in Bernstein form, quadtree
+// ---------------------------------------------------------------------------------------
+
+constexpr double kRelativeNormalTolerance = 1e-12;  // tau = 1e-12 scale^2
+constexpr double kUnitRoundoff = std::numeric_limits<double>::epsilon() / 2.0;
+
+// Rounding allowances of the two certificates after `depth` quadtree levels, from the error
+// bounds documented in bernstein.hpp (u = unit roundoff; P-bar = the same combination of
+// absolute values, "the scale of every error"; gamma_k ~ k u):
+//   N = r_u x r_v, bidegree (m_N, n_N): each component is a difference of two products of
+//     hodograph coordinates, so P-bar <= 2 S_u S_v; the products are within
+//     gamma_{min(m_N, n_N) + 5} of P-bar, and each level halves in u and then in v (de
+//     Casteljau at 1/2), adding gamma_{3 m_N} + gamma_{3 n_N}; d . N (|d| = 1) adds 3 u.
+//     Total: (min + 8 + 3 (m_N + n_N) depth) u 2 S_u S_v.
+//   f = |N|^2, bidegree (m_f, n_f): P-bar <= 3 (2 S_u S_v)^2 = 12 G (G = (S_u S_v)^2); the
+//     errors of N, doubled by squaring, plus the products' and the sum's own, plus the
+//     halvings: (2 min + 13 + 3 (m_f + n_f) depth) u 12 G.
+// Each is multiplied by a safety factor of 4, so that a proof is never an artefact of
+// rounding. For a bicubic patch at depth 16: 4.4e-13 S_u S_v and 5.2e-12 G.
+constexpr double kSlackSafety = 4.0;
+
+double slackDirectional(const Bernstein2& normalComponent, int depth, double boundProduct) {
+  const int low = std::min(normalComponent.degreeU, normalComponent.degreeV);
+  const int sum = normalComponent.degreeU + normalComponent.degreeV;
+  return kSlackSafety * (low + 8 + 3.0 * sum * depth) * kUnitRoundoff * 2.0 * boundProduct;
+}
+
+double slackSquared(const Bernstein2& f, const Bernstein2& normalComponent, int depth,
+                    double boundProduct) {
+  const int low = std::min(normalComponent.degreeU, normalComponent.degreeV);
+  const int sum = f.degreeU + f.degreeV;
+  return kSlackSafety * (2.0 * low + 13 + 3.0 * sum * depth) * kUnitRoundoff * 12.0 * boundProduct *
+         boundProduct;
+}
+
+double patchScale(const BezierPatch& patch) {
+  double scale = 0.0;
+  for (const Vec3& p : patch.control) {
+    scale = std::max({scale, std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+  }
+  return scale;
+}
+
+// S_u S_v with S_u = m max|p_{j+1,k} - p_jk|, S_v = n max|p_{j,k+1} - p_jk|: bounds of
+// |r_u| and |r_v| over the patch (the hodographs' control points are m (p_{j+1,k} - p_jk)
+// and n (p_{j,k+1} - p_jk), and a Bezier function lies in the convex hull of its control
+// points), the same bounds bezier.hpp's unitNormal uses.
+double derivativeBoundProduct(const BezierPatch& patch) {
+  const int m = patch.degreeU;
+  const int n = patch.degreeV;
+  double du = 0.0;
+  double dv = 0.0;
+  for (int j = 0; j <= m; ++j) {
+    for (int k = 0; k <= n; ++k) {
+      if (j < m) du = std::max(du, norm(patch.at(j + 1, k) - patch.at(j, k)));
+      if (k < n) dv = std::max(dv, norm(patch.at(j, k + 1) - patch.at(j, k)));
+    }
+  }
+  return m * du * n * dv;
+}
+
+// The polynomials of one quadtree cell [u0, u1] x [v0, v1], each in Bernstein form on the
+// cell (mapped to [0, 1]^2): f = |N|^2 and the components of N = r_u x r_v.
+struct Cell {
+  Bernstein2 f;
+  std::array<Bernstein2, 3> normal;
+  double u0 = 0.0;
+  double u1 = 1.0;
+  double v0 = 0.0;
+  double v1 = 1.0;
+};
+
+// The four quarters of p, in the order (low u, low v), (low u, high v), (high u, low v),
+// (high u, high v): halve in u, then each half in v (exact halving points).
+std::array<Bernstein2, 4> quartersOf(const Bernstein2& p) {
+  auto [low, high] = subdivideU(p, 0.5);
+  auto [lowLow, lowHigh] = subdivideV(low, 0.5);
+  auto [highLow, highHigh] = subdivideV(high, 0.5);
+  return {std::move(lowLow), std::move(lowHigh), std::move(highLow), std::move(highHigh)};
+}
+
+std::array<Cell, 4> quarters(const Cell& cell) {
+  const double um = 0.5 * (cell.u0 + cell.u1);
+  const double vm = 0.5 * (cell.v0 + cell.v1);
+  std::array<Cell, 4> result;
+  result[0].u0 = cell.u0, result[0].u1 = um, result[0].v0 = cell.v0, result[0].v1 = vm;
+  result[1].u0 = cell.u0, result[1].u1 = um, result[1].v0 = vm, result[1].v1 = cell.v1;
+  result[2].u0 = um, result[2].u1 = cell.u1, result[2].v0 = cell.v0, result[2].v1 = vm;
+  result[3].u0 = um, result[3].u1 = cell.u1, result[3].v0 = vm, result[3].v1 = cell.v1;
+  std::array<Bernstein2, 4> f = quartersOf(cell.f);
+  for (std::size_t q = 0; q < 4; ++q) result[q].f = std::move(f[q]);
+  for (std::size_t c = 0; c < 3; ++c) {
+    std::array<Bernstein2, 4> component = quartersOf(cell.normal[c]);
+    for (std::size_t q = 0; q < 4; ++q) result[q].normal[c] = std::move(component[q]);
+  }
+  return result;
+}
+
+// The directional certificate: with d the unit normal at the cell's centre, the smallest
+// Bernstein coefficient of d . N on the cell, a lower bound of d . N <= |N| there.
+double directionalLowerBound(const Cell& cell) {
+  const Vec3 d{evaluate(cell.normal[0], 0.5, 0.5), evaluate(cell.normal[1], 0.5, 0.5),
+               evaluate(cell.normal[2], 0.5, 0.5)};
+  const double length = norm(d);
+  if (!(length > 0.0)) return -std::numeric_limits<double>::infinity();
+  const Vec3 unit = d / length;
+  double lowest = std::numeric_limits<double>::infinity();
+  const std::vector<double>& nx = cell.normal[0].coefficients;
+  const std::vector<double>& ny = cell.normal[1].coefficients;
+  const std::vector<double>& nz = cell.normal[2].coefficients;
+  for (std::size_t i = 0; i < nx.size(); ++i) {
+    lowest = std::min(lowest, unit.x * nx[i] + unit.y * ny[i] + unit.z * nz[i]);
+  }
+  return lowest;
+}
+
+double normalLengthAt(const BezierPatch& patch, double u, double v) {
+  return norm(normalVector(patch, u, v));
+}
+
+}  // namespace
+
+PatchRegularity checkPatchRegularity(const BezierPatch& original) {
+  const bool shaped = original.degreeU >= 1 && original.degreeV >= 1 &&
+                      original.control.size() == static_cast<std::size_t>(original.degreeU + 1) *
+                                                     static_cast<std::size_t>(original.degreeV + 1);
+  const bool finite = std::all_of(
+      original.control.begin(), original.control.end(),
+      [](const Vec3& p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z); });
+  if (!shaped || !finite) {
+    throw Error(fmt::format(
+        "checkPatchRegularity: expected degrees >= 1, (m + 1)(n + 1) finite control points; got "
+        "degree [{}, {}] with {} points{}",
+        original.degreeU, original.degreeV, original.control.size(),
+        finite ? "" : ", not all finite"));
+  }
+  // Work on the patch scaled by a power of two (exact, barring underflow of coordinates
+  // far below the largest) so that its largest |coordinate| lies in [0.5, 1): the squares
+  // and fourth powers below can then neither overflow nor underflow, and the verdict is
+  // invariant under scaling by powers of two.
+  int exponent = 0;
+  std::frexp(patchScale(original), &exponent);
+  BezierPatch patch = original;
+  for (Vec3& p : patch.control) {
+    p = {std::ldexp(p.x, -exponent), std::ldexp(p.y, -exponent), std::ldexp(p.z, -exponent)};
+  }
+  const double scale = patchScale(patch);
+  PatchRegularity result;
+  result.threshold = kRelativeNormalTolerance;
+  const double tau = kRelativeNormalTolerance * scale * scale;
+  const double bound = derivativeBoundProduct(patch);
+
+  double least = std::numeric_limits<double>::infinity();
+  // Evaluates |r_u x r_v| at (u, v); returns true if it is small enough to prove the patch
+  // singular there. Keeps the least value seen as the location of an undecided verdict.
+  auto probe = [&](double u, double v) {
+    const double length = normalLengthAt(patch, u, v);
+    if (length < least) {
+      least = length;
+      result.u = u;
+      result.v = v;
+      result.relativeNormalLength = scale > 0.0 ? length / (scale * scale) : 0.0;
+    }
+    return length <= tau;
+  };
+
+  // Breadth first, one level at a time, so that the cell budget is spent evenly.
+  std::vector<Cell> level(1);
+  level[0].f = normalLengthSquared(patch);
+  level[0].normal = normalPolynomials(patch);
+  for (int depth = 0; !level.empty(); ++depth) {
+    // A cell is proven regular (|N| > tau on it, beyond rounding) when f's coefficients all
+    // exceed proofSquared, or the coefficients of d . N all exceed proofDirectional.
+    const Bernstein2& sample = level.front().normal[0];
+    const double proofSquared = tau * tau + slackSquared(level.front().f, sample, depth, bound);
+    const double proofDirectional = tau + slackDirectional(sample, depth, bound);
+    std::vector<Cell> unresolved;
+    for (Cell& cell : level) {
+      ++result.cells;
+      if (bounds(cell.f).lo > proofSquared) continue;                // all of f's > 0
+      if (directionalLowerBound(cell) > proofDirectional) continue;  // N within a half-space
+      const double um = 0.5 * (cell.u0 + cell.u1);
+      const double vm = 0.5 * (cell.v0 + cell.v1);
+      const bool singular = probe(um, vm) || probe(cell.u0, cell.v0) || probe(cell.u1, cell.v0) ||
+                            probe(cell.u0, cell.v1) || probe(cell.u1, cell.v1);
+      if (singular) {
+        result.verdict = RegularityVerdict::singular;
+        return result;
+      }
+      unresolved.push_back(std::move(cell));
+    }
+    if (unresolved.empty()) break;
+    const std::size_t next = result.cells + 4 * unresolved.size();
+    if (depth == kRegularityMaxDepth || next > kRegularityMaxCells) {
+      result.verdict = RegularityVerdict::undecided;
+      return result;
+    }
+    level.clear();
+    for (const Cell& cell : unresolved) {
+      for (Cell& quarter : quarters(cell)) level.push_back(std::move(quarter));
+    }
+  }
+  result.verdict = RegularityVerdict::regular;
+  result.u = 0.0;
+  result.v = 0.0;
+  result.relativeNormalLength = 0.0;
+  return result;
+}
+
+namespace {
+
+// ---------------------------------------------------------------------------------------
+// Validation of a patch in memory (degrees, sizes, finiteness, regularity)
+// ---------------------------------------------------------------------------------------
+
+void validatePatch(const BezierPatch& patch, std::size_t index) {
+  const std::string where = patchPath(index);
+  for (const auto& [degree, direction] :
+       {std::pair{patch.degreeU, "u (the first)"}, std::pair{patch.degreeV, "v (the second)"}}) {
+    if (degree < 1) {
+      throw Error(
+          fmt::format("{}.degree: degree {} in {} leaves the patch without a normal (r_{} vanishes "
+                      "identically); each degree must be at least 1",
+                      where, degree, direction, direction[0]));
+    }
+    if (degree > kMaxPatchDegree) {
+      throw Error(fmt::format("{}.degree: degree {} in {} exceeds the supported maximum {}", where,
+                              degree, direction, kMaxPatchDegree));
+    }
+  }
+  const std::size_t expected =
+      static_cast<std::size_t>(patch.degreeU + 1) * static_cast<std::size_t>(patch.degreeV + 1);
+  if (patch.control.size() != expected) {
+    throw Error(fmt::format("{}: degree [{}, {}] needs {} x {} = {} control points, got {}", where,
+                            patch.degreeU, patch.degreeV, patch.degreeU + 1, patch.degreeV + 1,
+                            expected, patch.control.size()));
+  }
+  for (int j = 0; j <= patch.degreeU; ++j) {
+    for (int k = 0; k <= patch.degreeV; ++k) {
+      const Vec3& p = patch.at(j, k);
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+        throw Error(
+            fmt::format("{}.control_points[{}][{}]: coordinates must be finite, got [{}, {}, {}]",
+                        where, j, k, p.x, p.y, p.z));
+      }
+    }
+  }
+  const PatchRegularity regularity = checkPatchRegularity(patch);
+  switch (regularity.verdict) {
+    case RegularityVerdict::regular:
+      return;
+    case RegularityVerdict::singular:
+      throw Error(fmt::format(
+          "{}: degenerate patch: r_u x r_v vanishes at (u, v) = ({}, {}) (|r_u x r_v| / scale^2 = "
+          "{:g} <= {:g}, scale = largest |coordinate| = {:g}), so the unit normal is undefined "
+          "there",
+          where, regularity.u, regularity.v, regularity.relativeNormalLength, regularity.threshold,
+          patchScale(patch)));
+    case RegularityVerdict::undecided:
+      throw Error(fmt::format(
+          "{}: degenerate patch: could not prove r_u x r_v != 0 near (u, v) = ({}, {}) "
+          "(|r_u x r_v| / scale^2 = {:g} there, after {} quadtree cells); the unit normal is "
+          "unreliable or undefined nearby",
+          where, regularity.u, regularity.v, regularity.relativeNormalLength, regularity.cells));
+  }
+}
+
+// ---------------------------------------------------------------------------------------
+// JSON parsing
+// ---------------------------------------------------------------------------------------
+
+[[noreturn]] void fail(const std::string& source, const std::string& where,
+                       const std::string& what) {
+  throw Error(fmt::format("{}: {}: {}", source, where, what));
+}
+
+void rejectUnknownKeys(const Json& object, std::initializer_list<std::string_view> known,
+                       const std::string& source, const std::string& where) {
+  for (const auto& item : object.items()) {
+    if (std::find(known.begin(), known.end(), item.key()) != known.end()) continue;
+    std::string expected;
+    for (const std::string_view key : known) {
+      expected += expected.empty() ? "" : ", ";
+      expected += fmt::format("\"{}\"", key);
+    }
+    fail(source, where, fmt::format("unknown key \"{}\" (expected {})", item.key(), expected));
+  }
+}
+
+Units parseUnits(const Json& document, const std::string& source) {
+  if (!document.contains("units")) {
+    throw Error(fmt::format("{}: missing \"units\" (\"in\" or \"mm\")", source));
+  }
+  const Json& units = document["units"];
+  if (units.is_string()) {
+    const std::string& name = units.get_ref<const std::string&>();
+    if (name == "in") return Units::inch;
+    if (name == "mm") return Units::millimetre;
+  }
+  fail(source, "units", fmt::format("expected \"in\" or \"mm\", got {}", quoted(units)));
+}
+
+int parseDegree(const Json& value, const char* direction, const std::string& source,
+                const std::string& where, const Json& degree) {
+  if (!value.is_number_integer()) {
+    fail(source, where,
+         fmt::format("expected [m, n], two integers, got {} (the degree in {} is not an integer)",
+                     quoted(degree), direction));
+  }
+  const std::int64_t d = value.is_number_unsigned()
+                             ? static_cast<std::int64_t>(std::min<std::uint64_t>(
+                                   value.get<std::uint64_t>(), std::uint64_t{1} << 62))
+                             : value.get<std::int64_t>();
+  if (d < 1) {
+    fail(source, where,
+         fmt::format("degree {} in {} (got {}): each degree must be at least 1, or r_{} vanishes "
+                     "identically and the patch has no normal",
+                     d, direction, quoted(degree), direction[0]));
+  }
+  if (d > kMaxPatchDegree) {
+    fail(source, where,
+         fmt::format("degree {} in {} (got {}) exceeds the supported maximum {}", d, direction,
+                     quoted(degree), kMaxPatchDegree));
+  }
+  return static_cast<int>(d);
+}
+
+Vec3 parsePoint(const Json& value, const std::string& source, const std::string& where) {
+  const bool shaped = value.is_array() && value.size() == 3 && value[0].is_number() &&
+                      value[1].is_number() && value[2].is_number();
+  if (!shaped)
+    fail(source, where, fmt::format("expected [x, y, z], three numbers, got {}", quoted(value)));
+  const Vec3 p{value[0].get<double>(), value[1].get<double>(), value[2].get<double>()};
+  // JSON has no NaN or infinity (and nlohmann rejects literals that overflow); kept as a
+  // guard so that the invariant never rests on the JSON library's behaviour.
+  if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+    fail(source, where, fmt::format("coordinates must be finite numbers, got {}", quoted(value)));
+  }
+  return p;
+}
+
+BezierPatch parsePatch(const Json& value, std::size_t index, const std::string& source) {
+  const std::string where = patchPath(index);
+  if (!value.is_object()) {
+    fail(source, where,
+         fmt::format("expected an object {{\"degree\": [m, n], \"control_points\": [...]}}, got {}",
+                     quoted(value)));
+  }
+  rejectUnknownKeys(value, {"degree", "control_points"}, source, where);
+  if (!value.contains("degree")) fail(source, where, "missing \"degree\": [m, n]");
+  if (!value.contains("control_points")) fail(source, where, "missing \"control_points\"");
+
+  const Json& degree = value["degree"];
+  const std::string degreeWhere = where + ".degree";
+  if (!degree.is_array() || degree.size() != 2) {
+    fail(source, degreeWhere, fmt::format("expected [m, n], two integers, got {}", quoted(degree)));
+  }
+  BezierPatch patch;
+  patch.degreeU = parseDegree(degree[0], "u (the first)", source, degreeWhere, degree);
+  patch.degreeV = parseDegree(degree[1], "v (the second)", source, degreeWhere, degree);
+  const std::size_t rows = static_cast<std::size_t>(patch.degreeU) + 1;
+  const std::size_t columns = static_cast<std::size_t>(patch.degreeV) + 1;
+
+  const Json& points = value["control_points"];
+  const std::string pointsWhere = where + ".control_points";
+  if (!points.is_array()) {
+    fail(source, pointsWhere,
+         fmt::format("expected an array of {} rows of {} points, got {}", rows, columns,
+                     quoted(points)));
+  }
+  if (points.size() != rows) {
+    fail(source, pointsWhere,
+         fmt::format("degree [{}, {}] needs m + 1 = {} rows, got {}", patch.degreeU, patch.degreeV,
+                     rows, points.size()));
+  }
+  patch.control.reserve(rows * columns);
+  for (std::size_t j = 0; j < rows; ++j) {
+    const Json& row = points[j];
+    const std::string rowWhere = fmt::format("{}[{}]", pointsWhere, j);
+    if (!row.is_array()) {
+      fail(source, rowWhere,
+           fmt::format("expected a row of {} points, got {}", columns, quoted(row)));
+    }
+    if (row.size() != columns) {
+      fail(source, rowWhere,
+           fmt::format("degree [{}, {}] needs n + 1 = {} points per row, got {}", patch.degreeU,
+                       patch.degreeV, columns, row.size()));
+    }
+    for (std::size_t k = 0; k < columns; ++k) {
+      patch.control.push_back(parsePoint(row[k], source, fmt::format("{}[{}]", rowWhere, k)));
+    }
+  }
+  return patch;
+}
+
+Surface parseDocument(const Json& document, const std::string& source) {
+  if (!document.is_object()) {
+    throw Error(fmt::format(
+        "{}: expected a JSON object {{\"units\": \"in\" or \"mm\", \"patches\": [...]}}, got {}",
+        source, quoted(document)));
+  }
+  rejectUnknownKeys(document, {"units", "patches"}, source, "top level");
+  Surface surface;
+  surface.units = parseUnits(document, source);
+  if (!document.contains("patches")) {
+    throw Error(fmt::format("{}: missing \"patches\" (an array of at least one patch)", source));
+  }
+  const Json& patches = document["patches"];
+  if (!patches.is_array()) {
+    fail(source, "patches", fmt::format("expected an array of patches, got {}", quoted(patches)));
+  }
+  if (patches.empty()) fail(source, "patches", "no patches; a surface needs at least one");
+  for (std::size_t i = 0; i < patches.size(); ++i) {
+    surface.patches.push_back(parsePatch(patches[i], i, source));
+  }
+  return surface;
+}
+
+// ---------------------------------------------------------------------------------------
+// Reading files
+// ---------------------------------------------------------------------------------------
+
+std::string readStream(std::FILE* stream, const std::string& name) {
+  std::string content;
+  char buffer[1 << 16];
+  std::size_t count = 0;
+  errno = 0;
+  while ((count = std::fread(buffer, 1, sizeof buffer, stream)) > 0) content.append(buffer, count);
+  if (std::ferror(stream) != 0) {
+    throw Error(fmt::format("cannot read '{}': {}", name, std::strerror(errno != 0 ? errno : EIO)));
+  }
+  return content;
+}
+
+std::string readWholeFile(const std::string& path) {
+  if (path == "-") return readStream(stdin, displayName(path));
+  errno = 0;
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (file == nullptr) {
+    throw Error(
+        fmt::format("cannot open '{}': {}", path, std::strerror(errno != 0 ? errno : ENOENT)));
+  }
+  try {
+    std::string content = readStream(file, path);
+    std::fclose(file);
+    return content;
+  } catch (...) {
+    std::fclose(file);
+    throw;
+  }
+}
+
+// ---------------------------------------------------------------------------------------
+// Built-in examples: the paper's Section 4
+// ---------------------------------------------------------------------------------------
+
+// A bicubic patch over the 3 x 3 grid p_jk = (k, j, z[j][k]), as both test surfaces are
+// printed: p_01 = (1, 0, .), p_10 = (0, 1, .), so k runs along x and j along y.
+// (With u along y and v along x, r_u x r_v points to -z where the surface is flat-ish; the
+// symmetrized Gauss map does not depend on the orientation.)
+BezierPatch gridBicubic(const double (&z)[4][4]) {
+  BezierPatch patch;
+  patch.degreeU = 3;
+  patch.degreeV = 3;
+  for (int j = 0; j <= 3; ++j) {
+    for (int k = 0; k <= 3; ++k) {
+      patch.control.push_back({static_cast<double>(k), static_cast<double>(j), z[j][k]});
+    }
+  }
+  return patch;
+}
+
+// Test surface #1, Section 4.1 (Fig. 1). Row j lists z of p_j0 .. p_j3 as printed.
+Surface paper1() {
+  constexpr double z[4][4] = {
+      {0.48, 1.00, 0.80, 0.40},  // p_00 .. p_03
+      {0.90, 1.41, 0.60, 0.60},  // p_10 .. p_13
+      {1.00, 0.88, 0.00, 0.72},  // p_20 .. p_23
+      {0.80, 0.60, 0.40, 0.80},  // p_30 .. p_33
+  };
+  return {Units::inch, {gridBicubic(z)}};
+}
+
+// Test surface #2, Section 4.2 (Fig. 8): symmetric under p_jk <-> p_kj (x <-> y).
+Surface paper2() {
+  constexpr double z[4][4] = {
+      {1.65, 3.05, 3.05, 2.05},  // p_00 .. p_03
+      {3.05, 0.00, 4.10, 3.05},  // p_10 .. p_13
+      {3.05, 4.10, 0.00, 3.05},  // p_20 .. p_23
+      {2.05, 3.05, 3.05, 1.65},  // p_30 .. p_33
+  };
+  return {Units::inch, {gridBicubic(z)}};
+}
+
+struct Example {
+  const char* name;
+  Surface (*make)();
+};
+
+constexpr Example kExamples[] = {
+    {"paper-1", paper1},
+    {"paper-2", paper2},
+};
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------
+// Public functions
+// ---------------------------------------------------------------------------------------
+
+std::string_view unitsName(Units units) { return units == Units::inch ? "in" : "mm"; }
+
+void validateSurface(const Surface& surface) {
+  if (surface.patches.empty()) throw Error("patches: no patches; a surface needs at least one");
+  for (std::size_t i = 0; i < surface.patches.size(); ++i) validatePatch(surface.patches[i], i);
+}
+
+Surface parseSurface(std::string_view json, const std::string& sourceName) {
+  const std::string source = displayName(sourceName);
+  // A UTF-8 byte order mark, as some editors write, is not content.
+  constexpr std::string_view kByteOrderMark = "\xEF\xBB\xBF";
+  if (json.substr(0, kByteOrderMark.size()) == kByteOrderMark) {
+    json.remove_prefix(kByteOrderMark.size());
+  }
+  Json document;
+  try {
+    document = Json::parse(json.begin(), json.end());
+  } catch (const Json::exception& error) {
+    // parse_error (syntax, with line and column), or out_of_range for a number literal
+    // beyond the range of a double.
+    throw Error(fmt::format("{}: malformed JSON: {}", source, withoutExceptionId(error.what())));
+  }
+  Surface surface = parseDocument(document, source);
+  try {
+    validateSurface(surface);
+  } catch (const Error& error) {
+    throw Error(fmt::format("{}: {}", source, error.what()));
+  }
+  return surface;
+}
+
+Surface readSurface(const std::string& path) { return parseSurface(readWholeFile(path), path); }
+
+std::string surfaceToJson(const Surface& surface) {
+  std::string out =
+      fmt::format("{{\n  \"units\": \"{}\",\n  \"patches\": [", unitsName(surface.units));
+  for (std::size_t i = 0; i < surface.patches.size(); ++i) {
+    const BezierPatch& patch = surface.patches[i];
+    // Only what the text needs: the shape (to index the rows) and finiteness (JSON has no
+    // NaN or infinity). Regularity is not checked: any such surface can be written.
+    const bool shaped = patch.degreeU >= 0 && patch.degreeV >= 0 &&
+                        patch.control.size() == static_cast<std::size_t>(patch.degreeU + 1) *
+                                                    static_cast<std::size_t>(patch.degreeV + 1);
+    const bool finite = std::all_of(patch.control.begin(), patch.control.end(), [](const Vec3& p) {
+      return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+    });
+    if (!shaped || !finite) {
+      throw Error(fmt::format(
+          "surfaceToJson: {}: degree [{}, {}] with {} control points{} cannot be written",
+          patchPath(i), patch.degreeU, patch.degreeV, patch.control.size(),
+          finite ? "" : " (not all finite)"));
+    }
+    out += i == 0 ? "\n" : ",\n";
+    out += fmt::format("    {{\n      \"degree\": [{}, {}],\n      \"control_points\": [",
+                       patch.degreeU, patch.degreeV);
+    for (int j = 0; j <= patch.degreeU; ++j) {
+      out += j == 0 ? "\n        [" : ",\n        [";
+      for (int k = 0; k <= patch.degreeV; ++k) {
+        const Vec3& p = patch.at(j, k);
+        out += fmt::format("{}[{}, {}, {}]", k == 0 ? "" : ", ", shortest(p.x), shortest(p.y),
+                           shortest(p.z));
+      }
+      out += "]";
+    }
+    out += "\n      ]\n    }";
+  }
+  out += surface.patches.empty() ? "]\n}\n" : "\n  ]\n}\n";
+  return out;
+}
+
+double surfaceScale(const Surface& surface) {
+  double scale = 0.0;
+  for (const BezierPatch& patch : surface.patches) scale = std::max(scale, patchScale(patch));
+  return scale;
+}
+
+std::vector<std::string> exampleSurfaceNames() {
+  std::vector<std::string> names;
+  for (const Example& example : kExamples) names.emplace_back(example.name);
+  return names;
+}
+
+Surface exampleSurface(const std::string& name) {
+  for (const Example& example : kExamples) {
+    if (name == example.name) return example.make();
+  }
+  std::string known;
+  for (const Example& example : kExamples) {
+    known += known.empty() ? "" : ", ";
+    known += example.name;
+  }
+  throw Error(fmt::format("unknown example surface '{}' (known: {})", name, known));
+}
+
+}  // namespace scallop

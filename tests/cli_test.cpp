@@ -4,19 +4,15 @@
 // with the library.
 
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <algorithm>
-#include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "cli_fixture.hpp"
 #include "scallop/chain.hpp"
 #include "scallop/chain_io.hpp"
 
@@ -26,68 +22,10 @@ namespace {
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
 
-struct RunResult {
-  int exitCode = -1;
-  std::string out;
-  std::string err;
-};
+using test::readFile;
+using test::RunResult;
 
-std::string readFile(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
-// A fresh directory for one run, and a second one for the captured stdout/stderr so that
-// the run's directory holds only what the program itself created.
-class Cli : public ::testing::Test {
- protected:
-  void SetUp() override {
-    workDir_ = makeTempDir("scallop-cli-");
-    captureDir_ = makeTempDir("scallop-cli-capture-");
-  }
-  void TearDown() override {
-    fs::remove_all(workDir_);
-    fs::remove_all(captureDir_);
-  }
-
-  static fs::path makeTempDir(const std::string& prefix) {
-    std::string pattern = (fs::temp_directory_path() / (prefix + "XXXXXX")).string();
-    if (::mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
-    return pattern;
-  }
-
-  void write(const std::string& name, const std::string& content) const {
-    std::ofstream(workDir_ / name, std::ios::binary) << content;
-  }
-
-  // Runs `scallop <arguments>` in the work directory. Arguments are passed through the
-  // shell: tests quote them as needed.
-  RunResult run(const std::string& arguments, const std::string& stdinFile = "") const {
-    const fs::path out = captureDir_ / "stdout";
-    const fs::path err = captureDir_ / "stderr";
-    std::string command = "cd '" + workDir_.string() + "' && '" SCALLOP_CLI_PATH "' " + arguments +
-                          " > '" + out.string() + "' 2> '" + err.string() + "'";
-    if (!stdinFile.empty()) command += " < '" + stdinFile + "'";
-    const int status = std::system(command.c_str());
-    RunResult result;
-    result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    result.out = readFile(out);
-    result.err = readFile(err);
-    return result;
-  }
-
-  std::vector<std::string> listing() const {
-    std::vector<std::string> names;
-    for (const auto& entry : fs::directory_iterator(workDir_)) {
-      names.push_back(entry.path().filename().string());
-    }
-    std::sort(names.begin(), names.end());
-    return names;
-  }
-
-  fs::path workDir_;
-  fs::path captureDir_;
-};
+class Cli : public test::CliFixture {};
 
 // ---------------------------------------------------------------------------------------
 // Bad input: non-zero exit, a message naming the place and value, nothing written.

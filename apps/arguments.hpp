@@ -1,0 +1,14 @@
+#pragma once
+// Numeric command-line arguments shared by the subcommands: parsed whole and
+// locale-independently, with an error that names the option and quotes the text.
+
+#include <string>
+
+namespace scallop::cli {
+
+/// A positive finite number: the whole of `text` (std::from_chars: locale-independent, no
+/// blanks, no trailing characters; one leading '+' allowed), or scallop::Error
+/// "invalid <what> '<text>': ..." (`expected` describes what would have been accepted).
+double parsePositive(const std::string& text, const char* what, const char* expected);
+
+}  // namespace scallop::cli

@@ -1,0 +1,227 @@
+// `scallop orient`: reads a surface of Bezier patches (a file, standard input or a built-in
+// example), computes its optimal slicing orientation N* (the direction of parallel planes
+// that meet the surface at the largest possible minimum angle alpha*), and writes JSON and/or
+// two SVG figures. Every output is computed into memory first and the files are then written
+// all or nothing, so a failed run leaves no output behind (not even the --svg-dir directory).
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <numbers>
+#include <string>
+#include <system_error>
+#include <vector>
+
+#include <fmt/format.h>
+#include <CLI/CLI.hpp>
+
+#include "arguments.hpp"
+#include "commands.hpp"
+#include "scallop/error.hpp"
+#include "scallop/file_output.hpp"
+#include "scallop/optimal_slicing.hpp"
+#include "scallop/orient_output.hpp"
+#include "scallop/surface.hpp"
+
+namespace scallop::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kStandardStream = "-";
+
+// The Gauss-map tolerance must stay well inside the library's limit (0.1 rad, about 5.7
+// degrees); beyond a few degrees the polygonal Gauss map is too coarse to mean much.
+constexpr double kMaxToleranceDeg = 5.0;
+
+constexpr const char* kSphereFigure = "gauss-map.svg";
+constexpr const char* kPlaneFigure = "stereographic.svg";
+
+struct OrientOptions {
+  std::string input;      // SURFACE.json, or "-" for standard input
+  std::string example;    // --example NAME
+  std::string tolerance;  // --tolerance DEG, parsed by parseTolerance
+  std::string jsonPath;   // --json OUT
+  std::string svgDir;     // --svg-dir DIR
+  bool noCertify = false;  // --no-certify
+};
+
+// Checks the combination of options, which CLI11 cannot express.
+void checkOptions(const OrientOptions& options) {
+  if (options.input.empty() == options.example.empty()) {
+    throw CLI::ValidationError("orient",
+                               "give the surface either as SURFACE.json or as --example NAME");
+  }
+  if (options.svgDir == kStandardStream) {
+    throw CLI::ValidationError("orient", "--svg-dir needs a directory, not standard output");
+  }
+}
+
+// The library's default tolerance in degrees, rounded to drop the conversion's last-bit noise
+// (0.5 deg -> rad -> deg may not come back as exactly 0.5).
+double defaultToleranceDeg() {
+  return std::round(toDegrees(OptimalSlicingOptions{}.toleranceRad) * 1e9) / 1e9;
+}
+
+// Degrees in (0, kMaxToleranceDeg).
+double parseTolerance(const std::string& text) {
+  const double degrees =
+      parsePositive(text, "tolerance", "a positive angle in degrees, below 5");
+  if (!(degrees < kMaxToleranceDeg)) {
+    throw Error(fmt::format("invalid tolerance '{}': must be below {} degrees", text,
+                            kMaxToleranceDeg));
+  }
+  return degrees;
+}
+
+// Where the JSON goes: --json, or standard output when no output is named at all.
+std::string jsonDestination(const OrientOptions& options) {
+  if (!options.jsonPath.empty()) return options.jsonPath;
+  return options.svgDir.empty() ? std::string(kStandardStream) : std::string();
+}
+
+std::string sourceName(const OrientOptions& options) {
+  if (!options.example.empty()) return "example " + options.example;
+  return options.input == kStandardStream ? std::string("<stdin>") : options.input;
+}
+
+// Creates `directory` and any missing parents; returns those it created, deepest first, so
+// that a failed run can remove them again.
+std::vector<fs::path> createDirectories(const fs::path& directory) {
+  std::vector<fs::path> missing;
+  for (fs::path p = directory; !p.empty() && !fs::exists(p); p = p.parent_path()) {
+    missing.push_back(p);
+    if (p == p.parent_path()) break;
+  }
+  std::error_code error;
+  fs::create_directories(directory, error);
+  if (error) {
+    throw Error(fmt::format("cannot create directory '{}': {}", directory.string(),
+                            error.message()));
+  }
+  return missing;
+}
+
+// Writes the outputs all or nothing, creating the figures' directory first; on failure
+// removes the directories this run created (they are empty again by then).
+void writeOutputs(const std::vector<OutputFile>& outputs, const std::string& svgDir) {
+  const std::vector<fs::path> created = svgDir.empty() ? std::vector<fs::path>{}
+                                                       : createDirectories(svgDir);
+  try {
+    writeFilesAtomically(outputs);
+  } catch (...) {
+    std::error_code ignored;
+    for (const fs::path& directory : created) fs::remove(directory, ignored);
+    throw;
+  }
+}
+
+std::string certificateSummary(const OptimalSlicing& result, bool certify) {
+  if (!certify) return "not certified (--no-certify)";
+  if (result.certified) {
+    return fmt::format("certified alpha >= {:.4f} deg ({} cells)",
+                       toDegrees(result.certifiedAlphaRad), result.certificateCells);
+  }
+  return fmt::format("NOT certified ({} cells)", result.certificateCells);
+}
+
+void printSummary(const std::string& source, const OptimalSlicing& result, bool certify,
+                  const std::vector<OutputFile>& outputs) {
+  std::string written;
+  for (const OutputFile& output : outputs) {
+    written += (written.empty() ? "" : ", ") + output.path;
+  }
+  fmt::print(stderr,
+             "scallop: {}: N* = ({:.6f}, {:.6f}, {:.6f}), alpha* = {:.4f} deg, {}, {} boundary "
+             "segments, {:.3f} s -> {}\n",
+             source, result.normal.x, result.normal.y, result.normal.z,
+             toDegrees(result.alphaRad), certificateSummary(result, certify),
+             result.gaussMap.boundarySegments, result.seconds, written);
+}
+
+void runOrient(const OrientOptions& options) {
+  checkOptions(options);
+  OptimalSlicingOptions slicingOptions;  // the library's default tolerance unless given
+  double toleranceDeg = defaultToleranceDeg();
+  if (!options.tolerance.empty()) {
+    toleranceDeg = parseTolerance(options.tolerance);
+    slicingOptions.toleranceRad = toleranceDeg * (std::numbers::pi / 180.0);
+  }
+  slicingOptions.certify = !options.noCertify;
+
+  const Surface surface =
+      options.example.empty() ? readSurface(options.input) : exampleSurface(options.example);
+  const OptimalSlicing result = optimalSlicing(surface, slicingOptions);
+
+  std::vector<OutputFile> outputs;
+  const std::string jsonPath = jsonDestination(options);
+  if (!jsonPath.empty()) outputs.push_back({jsonPath, orientationToJson(result, toleranceDeg)});
+  if (!options.svgDir.empty()) {
+    const fs::path dir = options.svgDir;
+    outputs.push_back({(dir / kSphereFigure).string(), gaussMapSphereSvg(result)});
+    outputs.push_back({(dir / kPlaneFigure).string(), stereographicSvg(result)});
+  }
+  writeOutputs(outputs, options.svgDir);
+
+  // The summary goes to stderr, but stays quiet when the JSON is piped on standard output.
+  if (jsonPath != kStandardStream) {
+    printSummary(sourceName(options), result, slicingOptions.certify, outputs);
+  }
+}
+
+}  // namespace
+
+void addOrientCommand(CLI::App& app) {
+  // Owned by the callback, which outlives this function (CLI11's pattern for subcommands
+  // defined in their own file).
+  auto options = std::make_shared<OrientOptions>();
+  CLI::App* orient = app.add_subcommand(
+      "orient", "Optimal slicing orientation of a free-form surface, as JSON and/or SVG figures");
+  orient->footer(
+      "Computes the direction N* of parallel slicing planes N* . r = k Delta that maximises the "
+      "least angle alpha* between the planes' normal and the surface normals +-n (Smith, "
+      "Farouki, al-Kandari, Pottmann 2002): symmetrized Gauss map, stereographic projection, "
+      "medial axis, eqs (12)-(14), then a Bernstein-form certificate that no surface normal "
+      "comes within alpha* of +-N*. Writes JSON (to standard output if neither --json nor "
+      "--svg-dir is given) and/or two figures, DIR/gauss-map.svg (the Gauss map and the optimal "
+      "circle on the sphere) and DIR/stereographic.svg (the stereographic plane with the medial "
+      "axis); outputs are written all or nothing.\n"
+      "Input: JSON {\"units\": \"in\"|\"mm\", \"patches\": [{\"degree\": [m, n], "
+      "\"control_points\": [[[x, y, z], ... n + 1], ... m + 1 rows]}, ...]}; every patch must "
+      "be regular (r_u x r_v != 0).\n"
+      "Example: scallop orient --example paper-2 --json out.json --svg-dir figs");
+
+  CLI::Option* file =
+      orient
+          ->add_option("SURFACE", options->input,
+                       "surface file (JSON, Bezier patches); - reads standard input")
+          ->type_name("");
+  CLI::Option* example =
+      orient->add_option("--example", options->example, "use a built-in example surface instead")
+          ->check(CLI::IsMember(exampleSurfaceNames()))
+          ->type_name("NAME");
+  file->excludes(example);
+  orient
+      ->add_option("--tolerance", options->tolerance,
+                   fmt::format("angular tolerance of the Gauss map's polygonal boundary, in "
+                               "degrees, in (0, {}); default {}. Smaller is more accurate and "
+                               "slower",
+                               kMaxToleranceDeg, defaultToleranceDeg()))
+      ->type_name("DEG");
+  orient
+      ->add_option("--json", options->jsonPath,
+                   "write N*, alpha*, the certificate and statistics as JSON to OUT (- = "
+                   "standard output)")
+      ->type_name("OUT");
+  orient
+      ->add_option("--svg-dir", options->svgDir,
+                   "write the figures gauss-map.svg and stereographic.svg into DIR (created "
+                   "if missing)")
+      ->type_name("DIR");
+  orient->add_flag("--no-certify", options->noCertify,
+                   "skip the Bernstein-form certificate (faster; \"certified\" is then false)");
+  orient->callback([options] { runOrient(*options); });
+}
+
+}  // namespace scallop::cli

@@ -1,0 +1,66 @@
+#pragma once
+// Outputs of an optimal slicing orientation (the `scallop orient` command): its JSON form and
+// two self-contained SVG figures in the spirit of Smith, Farouki, al-Kandari, Pottmann,
+// "Optimal slicing of free-form surfaces" (2002), Figs 3, 4, 5, 10, 11 and 12.
+//
+// JSON (keys in this order; numbers are the shortest text that round-trips to the same
+// double, so every value is the in-memory one bit for bit; angles in degrees by toDegrees):
+//   {"normal": [x, y, z]                     N*, unit (+-N* slice alike),
+//    "alpha_deg": a                          alpha*, the least angle between N* and +-n,
+//    "certified": bool, "certified_alpha_deg": a, "certificate_cells": k
+//                                            what the Bernstein-form certificate proved
+//                                            (false, 0, 0 when it was not run),
+//    "method": "medial-axis" | "plane" | "curve",
+//    "circle": {"center": [x, y], "radius": R} | null
+//                                            the maximal circle in the pole frame's
+//                                            stereographic plane (null unless medial-axis),
+//    "sphere_circle": {"center": [x, y, z], "alpha_deg": a}
+//                                            the optimal circle on the sphere (original frame),
+//    "pole": [x, y, z]                       the surface normal used as the pole,
+//    "tolerance_deg": t                      the Gauss-map tolerance the caller used,
+//    "gauss_map": {"kind": "region" | "curve" | "point", "loops", "open_chains",
+//                  "boundary_segments", "parabolic_curves", "candidate_pieces",
+//                  "membership_tests"}       counts,
+//    "medial_axis": {"edges", "rebuilds"},
+//    "seconds": s}                           wall time of optimalSlicing
+//
+// Figures (fixed-point numbers only: no exponent, nan or inf; deterministic):
+//   gaussMapSphereSvg: the symmetrized Gauss map Omega on the unit sphere, in two
+//     orthographic views, both with N* in front: one tilted 45 degrees from N* towards the
+//     pole p (a surface normal, so the part of Omega around p is in front) and one tilted
+//     towards -p (the part around -p in front), so that together they show where the circle
+//     touches Omega on both sides, as the paper's Fig. 5 does. Each view: the sphere's
+//     outline, equator and meridians (original frame, z up) faint, Omega's visible part
+//     shaded, its boundary solid where visible and dashed where hidden, the optimal circle
+//     (centre N*, angular radius alpha*) likewise, N* marked, the axes' directions, a legend
+//     and a title giving N* and alpha*.
+//   stereographicSvg: the stereographic plane of the pole frame (Figs 4 and 11): Omega
+//     shaded (even-odd rule over the boundary loops), its boundary loops, the medial axis of
+//     the complement (thin), the optimal circle and its centre, the unit circle dashed (the
+//     image of the equator), the origin (the image of -p) and the axes. The image of the part
+//     of Omega around p is large and the part around -p small (the paper's "barely
+//     distinguishable" south cap), so there are two panels with linear scales: the whole
+//     domain, and a zoom centred on the origin fitted to the innermost loop around it (its
+//     region is outlined in the first panel). Each panel has its own scale bar.
+// Both throw scallop::Error if a coordinate they would draw is not finite.
+
+#include <numbers>
+#include <string>
+
+#include "scallop/optimal_slicing.hpp"
+
+namespace scallop {
+
+/// Radians to degrees, as every "*_deg" key of orientationToJson is computed.
+constexpr double toDegrees(double radians) { return radians * (180.0 / std::numbers::pi); }
+
+/// The JSON form of `result` (see above); `toleranceDeg` is recorded as "tolerance_deg".
+std::string orientationToJson(const OptimalSlicing& result, double toleranceDeg);
+
+/// The symmetrized Gauss map and the optimal circle on the unit sphere (see above).
+std::string gaussMapSphereSvg(const OptimalSlicing& result);
+
+/// The pole frame's stereographic plane: loops, medial axis, optimal circle (see above).
+std::string stereographicSvg(const OptimalSlicing& result);
+
+}  // namespace scallop

@@ -1,0 +1,144 @@
+#pragma once
+// Free-form surfaces made of tensor-product Bezier patches: the file format, validation
+// (including regularity, r_u x r_v != 0 on the whole patch), and the two bicubic test
+// surfaces of Smith, Farouki, al-Kandari, Pottmann, "Optimal slicing of free-form surfaces",
+// Section 4.
+//
+// File format (JSON)
+// ------------------
+//   {"units": "in" | "mm",
+//    "patches": [{"degree": [m, n],
+//                 "control_points": [[[x, y, z], ... n + 1 points], ... m + 1 rows]}, ...]}
+// control_points[j][k] is the paper's p_jk, the coefficient of b_j^m(u) b_k^n(v) (eq 1):
+// row j runs along v. Both keys are required at each level and no other key is accepted (a
+// misspelt key is an error, not silently ignored). Coordinates are in the given units.
+//
+// Contract
+// --------
+// A valid surface has at least one patch; each patch has degrees 1 <= m, n <=
+// kMaxPatchDegree, (m + 1)(n + 1) finite control points, and is regular: with
+// scale = the largest |coordinate| of its control points, |r_u x r_v| > tau = 1e-12 scale^2
+// at every (u, v) in [0, 1]^2, so that its unit normal (eq 2) is defined everywhere.
+// Degree 0 in a direction is rejected: r_u or r_v would vanish identically. (Accepted
+// patches also satisfy |r_u x r_v| > 1e-12 S_u S_v, above the threshold where bezier.hpp's
+// unitNormal throws, so unitNormal never throws on them.)
+//
+// Regularity (checkPatchRegularity) is decided by a breadth-first quadtree on [0, 1]^2,
+// with N = r_u x r_v and f = |N|^2 in tensor Bernstein form (bezier.hpp's
+// normalPolynomials, bidegree (2m-1, 2n-1), and normalLengthSquared, (4m-2, 4n-2)),
+// subdivided at cell midpoints by de Casteljau. For each cell:
+//   1. proof, f: every Bernstein coefficient of f on the cell exceeds tau^2 + slack_f:
+//      f is a convex combination of its coefficients, so |N| > tau on the cell;
+//   2. proof, direction: with d the unit normal at the cell's centre, every coefficient of
+//      d . N exceeds tau + slack_N: then |N| >= d . N > tau. This is sharper than 1
+//      (rounding enters at the level of |N|, not |N|^2) and settles patches whose |N| is
+//      tiny somewhere yet well above tau, such as nearly collapsed boundary rows;
+//   3. otherwise |r_u x r_v| is evaluated directly at the cell's centre and corners; a value
+//      <= tau proves the patch singular there (collapsed boundary rows or columns,
+//      collinear control nets, cusps along dyadic lines are found so, at the first cells);
+//   4. otherwise the cell is split in four, to depth kRegularityMaxDepth and at most
+//      kRegularityMaxCells cells in all. A cell still unresolved then makes the verdict
+//      "undecided": |N| comes within rounding of tau near there, or the patch is singular at
+//      a non-dyadic point (an isolated zero of N is located only to the cell's size).
+//      Undecided patches are rejected as degenerate too, with the location.
+// slack_f and slack_N are the rounding errors of the coefficients after `depth` halvings,
+// from bernstein.hpp's documented bounds, times 4 (surface.cpp derives them), in terms of
+// S_u S_v >= |r_u| |r_v| (S_u = m max|p_{j+1,k} - p_jk|, S_v = n max|p_{j,k+1} - p_jk|): a
+// proof is never an artefact of rounding. The check runs on the patch scaled by a power of
+// two to scale in [0.5, 1) (exact), so it cannot overflow and its verdict is invariant under
+// such scaling.
+// Time: O((mn)^2) for the Bernstein forms plus O(mn(m + n)) per cell; c = 1 cell for
+// typical patches (the paper's test surfaces: 1 each); a rejected undecided patch costs up
+// to kRegularityMaxCells cells (about 0.1 s for a bicubic).
+//
+// Errors: scallop::Error, the message naming the source ("<stdin>" for "-"), the patch
+// index, the row and point index where it applies, and the offending value, e.g.
+//   "s.json: patches[1].control_points[2][0]: expected [x, y, z], three finite numbers, got [1,2]".
+
+#include <cstddef>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "scallop/bezier.hpp"
+
+namespace scallop {
+
+enum class Units {
+  inch,        ///< "in": the paper's test surfaces
+  millimetre,  ///< "mm"
+};
+
+/// The file's spelling of the units: "in" or "mm".
+std::string_view unitsName(Units units);
+
+/// A surface: patches sharing one unit of length. The patches need not join; each is
+/// treated on its own (the symmetrized Gauss map of the surface is the union of theirs).
+/// Invariant (checked by validateSurface, guaranteed by parseSurface and exampleSurface):
+/// see the contract above.
+struct Surface {
+  Units units = Units::inch;
+  std::vector<BezierPatch> patches;
+};
+
+/// Largest degree accepted in either direction. It bounds the cost of the regularity check,
+/// whose Bernstein form has (4m - 1)(4n - 1) coefficients.
+constexpr int kMaxPatchDegree = 20;
+
+/// Quadtree limits of the regularity check (see the contract).
+constexpr int kRegularityMaxDepth = 16;
+constexpr std::size_t kRegularityMaxCells = 20000;
+
+/// Parses and validates a surface from JSON text; `sourceName` (a file name, or "-" for
+/// standard input) is used in error messages.
+Surface parseSurface(std::string_view json, const std::string& sourceName);
+
+/// Reads, parses and validates a surface file ("-" reads standard input).
+Surface readSurface(const std::string& path);
+
+/// The surface as JSON in the file format, one row of control points per line. Numbers are
+/// written shortest-round-trip (-0 as -0.0), so parseSurface(surfaceToJson(s)) reproduces
+/// every coordinate bit for bit. Deterministic. Writes any surface whose patches have
+/// degrees >= 0 and the matching number of finite control points (regularity is not
+/// checked); throws scallop::Error otherwise.
+std::string surfaceToJson(const Surface& surface);
+
+/// Throws scallop::Error ("patches[i]...: ...") unless `surface` satisfies the contract.
+void validateSurface(const Surface& surface);
+
+enum class RegularityVerdict {
+  regular,    ///< |r_u x r_v| > tau proven on all of [0, 1]^2
+  singular,   ///< found (u, v) with |r_u x r_v| <= tau
+  undecided,  ///< neither, within the quadtree limits (treated as degenerate)
+};
+
+/// The outcome of the regularity check of one patch.
+struct PatchRegularity {
+  RegularityVerdict verdict = RegularityVerdict::regular;
+  double u = 0.0;  ///< singular / undecided: where (the least |r_u x r_v| seen)
+  double v = 0.0;
+  double relativeNormalLength = 0.0;  ///< |r_u x r_v| / scale^2 at (u, v)
+  double threshold = 1e-12;           ///< tau / scale^2: singular if relativeNormalLength <= this
+  std::size_t cells = 0;  ///< quadtree cells examined (1 when f's coefficients are positive)
+};
+
+/// Decides whether a patch is regular (see the contract). The patch must have degrees >= 1
+/// and (m + 1)(n + 1) finite control points.
+PatchRegularity checkPatchRegularity(const BezierPatch& patch);
+
+/// The largest |coordinate| over all control points (0 for no patches): the length scale
+/// for tolerances.
+double surfaceScale(const Surface& surface);
+
+/// Names of the built-in example surfaces, and one of them by name (throws on an unknown
+/// name). Both are the bicubic test surfaces of the paper's Section 4, in inches, on a
+/// 3 x 3 inch footprint with p_jk = (k, j, z_jk):
+///   "paper-1"  test surface #1 (Section 4.1, Fig. 1); the paper's optimum
+///              N* = (0.248, -0.969, 0.001), eq (18);
+///   "paper-2"  test surface #2 (Section 4.2, Fig. 8), symmetric under p_jk <-> p_kj;
+///              N* = (0.975, -0.221, -0.002), eq (19).
+/// The same surfaces are in examples/surfaces/<name>.json.
+std::vector<std::string> exampleSurfaceNames();
+Surface exampleSurface(const std::string& name);
+
+}  // namespace scallop

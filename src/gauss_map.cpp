@@ -1,0 +1,580 @@
+// The symmetrized Gauss map: candidate curves (patch boundaries and parabolic lines), their
+// cutting at intersections, and the selection of the true boundary by membership tests.
+// See include/scallop/gauss_map.hpp for the contract.
+
+#include "scallop/gauss_map.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <map>
+#include <unordered_map>
+#include <fmt/format.h>
+#include <boost/polygon/polygon.hpp>
+
+#include "scallop/bernstein.hpp"
+#include "scallop/bezier.hpp"
+#include "scallop/error.hpp"
+
+namespace scallop {
+namespace {
+
+struct UV {
+  double u = 0.0;
+  double v = 0.0;
+};
+
+double angleBetween(const Vec3& a, const Vec3& b) {
+  // atan2(|a x b|, a . b): accurate for small and large angles alike.
+  return std::atan2(norm(cross(a, b)), dot(a, b));
+}
+
+// Everything a patch needs for the Gauss map, computed once.
+struct PatchData {
+  const BezierPatch* patch = nullptr;
+  std::array<Bernstein2, 3> normal;  // r_u x r_v, exact Bernstein form
+  Bernstein2 curvature;              // Gaussian curvature numerator (sign of K)
+  Bernstein2 curvatureU;             // its partial derivatives
+  Bernstein2 curvatureV;
+  bool developable = false;          // K = 0 identically (to rounding)
+};
+
+PatchData makePatchData(const BezierPatch& patch) {
+  PatchData data;
+  data.patch = &patch;
+  data.normal = normalPolynomials(patch);
+  data.curvature = gaussianCurvatureNumerator(patch);
+  data.curvatureU = derivativeU(data.curvature);
+  data.curvatureV = derivativeV(data.curvature);
+  // K's numerator is (r_uu . N)(r_vv . N) - (r_uv . N)^2, of the order of |N|^3 |r''|: call it
+  // identically zero when every coefficient is below 1e-12 of that scale.
+  const Bounds nb = bounds(normalLengthSquared(patch));
+  const double nScale = std::sqrt(std::max(std::abs(nb.lo), std::abs(nb.hi)));
+  double second = 0.0;
+  for (const auto& [du, dv] : {std::pair{2, 0}, std::pair{1, 1}, std::pair{0, 2}}) {
+    for (double u : {0.0, 0.5, 1.0}) {
+      for (double v : {0.0, 0.5, 1.0}) second = std::max(second, norm(secondDerivative(patch, u, v, du, dv)));
+    }
+  }
+  double largest = 0.0;
+  for (double c : data.curvature.coefficients) largest = std::max(largest, std::abs(c));
+  data.developable = largest <= 1e-12 * std::max(1e-300, nScale * nScale * second * second);
+  return data;
+}
+
+Bernstein2 combine(const std::array<Bernstein2, 3>& n, const Vec3& w) {
+  Bernstein2 out = n[0];
+  for (std::size_t i = 0; i < out.coefficients.size(); ++i) {
+    out.coefficients[i] = w.x * n[0].coefficients[i] + w.y * n[1].coefficients[i] +
+                          w.z * n[2].coefficients[i];
+  }
+  return out;
+}
+
+bool strictSign(const Bernstein2& p) {
+  const Bounds b = bounds(p);
+  return b.lo > 0.0 || b.hi < 0.0;
+}
+
+// ---------------------------------------------------------------------------------------
+// Membership: is m a unit normal of the patch? r_u x r_v = N must be parallel to m with
+// N . m > 0: with e1, e2 spanning the plane orthogonal to m, f1 = N . e1 and f2 = N . e2
+// vanish together while g = N . m > 0. Cells where f1 or f2 keeps a strict sign, or g <= 0,
+// are excluded (the Bernstein coefficients bound the polynomial); the surviving small cells
+// are confirmed by Newton's method on (f1, f2).
+// ---------------------------------------------------------------------------------------
+
+struct MembershipCell {
+  Bernstein2 f1, f2, g;
+  double u0, u1, v0, v1;
+  int depth;
+};
+
+// Whether r_u x r_v (given in Bernstein form over some parameter box, mapped to [0, 1]^2)
+// is a positive multiple of m somewhere on the box.
+bool hasNormal(const std::array<Bernstein2, 3>& normal, const Vec3& m) {
+  const Vec3 helper = std::abs(m.x) < 0.6 ? Vec3{1.0, 0.0, 0.0} : Vec3{0.0, 1.0, 0.0};
+  const Vec3 e1 = normalized(cross(m, helper));
+  const Vec3 e2 = cross(m, e1);
+  const Bernstein2 f1 = combine(normal, e1);
+  const Bernstein2 f2 = combine(normal, e2);
+  const Bernstein2 g = combine(normal, m);
+  const Bernstein2 f1u = derivativeU(f1), f1v = derivativeV(f1);
+  const Bernstein2 f2u = derivativeU(f2), f2v = derivativeV(f2);
+
+  auto newton = [&](double u, double v, double lo0, double hi0, double lo1, double hi1) {
+    for (int i = 0; i < 30; ++i) {
+      const double a = evaluate(f1, u, v), b = evaluate(f2, u, v);
+      const double j11 = evaluate(f1u, u, v), j12 = evaluate(f1v, u, v);
+      const double j21 = evaluate(f2u, u, v), j22 = evaluate(f2v, u, v);
+      const double det = j11 * j22 - j12 * j21;
+      if (det == 0.0 || !std::isfinite(det)) return false;
+      const double du = (a * j22 - b * j12) / det;
+      const double dv = (j11 * b - j21 * a) / det;
+      u -= du;
+      v -= dv;
+      if (!(u >= lo0 && u <= hi0 && v >= lo1 && v <= hi1)) return false;
+      if (std::abs(du) + std::abs(dv) < 1e-13) {
+        return u >= 0.0 && u <= 1.0 && v >= 0.0 && v <= 1.0 && evaluate(g, u, v) > 0.0;
+      }
+    }
+    return false;
+  };
+
+  // A cell is excluded only when a polynomial keeps its sign by more than its rounding
+  // (a few ulps of its largest coefficient): a root on a cell's edge (a normal of the
+  // patch boundary) must not be excluded by the sign of a rounding error.
+  auto margin = [](const Bernstein2& p) {
+    double largest = 0.0;
+    for (double c : p.coefficients) largest = std::max(largest, std::abs(c));
+    return 64.0 * std::numeric_limits<double>::epsilon() * largest;
+  };
+  const double m1 = margin(f1), m2 = margin(f2), mg = margin(g);
+  auto keepsSign = [](const Bernstein2& p, double eps) {
+    const Bounds b = bounds(p);
+    return b.lo > eps || b.hi < -eps;
+  };
+  std::vector<MembershipCell> stack;
+  stack.push_back({f1, f2, g, 0.0, 1.0, 0.0, 1.0, 0});
+  int visited = 0;
+  while (!stack.empty()) {
+    MembershipCell cell = std::move(stack.back());
+    stack.pop_back();
+    if (++visited > 200000) return true;  // pathological: call it a normal (conservative)
+    if (keepsSign(cell.f1, m1) || keepsSign(cell.f2, m2) || bounds(cell.g).hi < -mg) continue;
+    const double width = cell.u1 - cell.u0;
+    if (width <= 1.0 / 64.0) {
+      const double reach = width;
+      if (newton(0.5 * (cell.u0 + cell.u1), 0.5 * (cell.v0 + cell.v1), cell.u0 - reach,
+                 cell.u1 + reach, cell.v0 - reach, cell.v1 + reach)) {
+        return true;
+      }
+      // A root the Bernstein bounds cannot exclude but Newton does not reach: near a double
+      // root (a fold). Keep subdividing to the resolution, then give the benefit of doubt.
+      if (width <= 1e-9) return true;
+    }
+    const double um = 0.5 * (cell.u0 + cell.u1);
+    const double vm = 0.5 * (cell.v0 + cell.v1);
+    auto [f1l, f1r] = subdivideU(cell.f1, 0.5);
+    auto [f2l, f2r] = subdivideU(cell.f2, 0.5);
+    auto [gl, gr] = subdivideU(cell.g, 0.5);
+    for (int side = 0; side < 2; ++side) {
+      const Bernstein2& a = side == 0 ? f1l : f1r;
+      const Bernstein2& b = side == 0 ? f2l : f2r;
+      const Bernstein2& c = side == 0 ? gl : gr;
+      const double u0 = side == 0 ? cell.u0 : um;
+      const double u1 = side == 0 ? um : cell.u1;
+      auto [a0, a1] = subdivideV(a, 0.5);
+      auto [b0, b1] = subdivideV(b, 0.5);
+      auto [c0, c1] = subdivideV(c, 0.5);
+      stack.push_back({std::move(a0), std::move(b0), std::move(c0), u0, u1, cell.v0, vm, cell.depth + 1});
+      stack.push_back({std::move(a1), std::move(b1), std::move(c1), u0, u1, vm, cell.v1, cell.depth + 1});
+    }
+  }
+  return false;
+}
+
+bool patchHasNormal(const PatchData& data, const Vec3& m) { return hasNormal(data.normal, m); }
+
+bool inOmega(const std::vector<PatchData>& patches, const Vec3& m) {
+  for (const PatchData& p : patches) {
+    if (patchHasNormal(p, m) || patchHasNormal(p, -m)) return true;
+  }
+  return false;
+}
+
+// ---------------------------------------------------------------------------------------
+// Candidate curves on the sphere.
+// ---------------------------------------------------------------------------------------
+
+// Samples the unit normal along a parameter curve c(s), s in [0, 1], refining by halving
+// until the normal at each segment's middle parameter is within `tol` of the normalised
+// chord midpoint (the polygon's deviation from the curve), and no segment spans more than
+// `maxStep` (so that a wiggle between samples is not missed).
+void sampleNormals(const std::function<Vec3(double)>& normalAt, double s0, double s1,
+                   const Vec3& n0, const Vec3& n1, double tol, double maxStep, int depth,
+                   std::vector<Vec3>& out) {
+  const double sm = 0.5 * (s0 + s1);
+  const Vec3 nm = normalAt(sm);
+  const Vec3 chord = n0 + n1;
+  const double chordLength = norm(chord);
+  const bool flat = chordLength > 0.0 && angleBetween(nm, chord / chordLength) <= tol &&
+                    angleBetween(n0, n1) <= maxStep;
+  if (flat || depth >= 40) {
+    out.push_back(n1);
+    return;
+  }
+  sampleNormals(normalAt, s0, sm, n0, nm, tol, maxStep, depth + 1, out);
+  sampleNormals(normalAt, sm, s1, nm, n1, tol, maxStep, depth + 1, out);
+}
+
+std::vector<Vec3> normalCurve(const std::function<Vec3(double)>& normalAt, double tol) {
+  std::vector<Vec3> out{normalAt(0.0)};
+  const double maxStep = std::max(64.0 * tol, 0.05);
+  sampleNormals(normalAt, 0.0, 1.0, out.front(), normalAt(1.0), tol, maxStep, 0, out);
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------
+// The Gauss image as a union of cell images. A quadtree over each patch stops at cells of
+// two kinds:
+// - regular cells, where the curvature numerator keeps a strict sign (so the Gauss map is
+//   a local diffeomorphism) and the normals vary by less than kRegularCellSpread: the image
+//   is the region bounded by the images of the cell's four edges, sampled to the tolerance;
+// - fold cells, across a parabolic line (or too curved), subdivided until their normals
+//   vary by less than the tolerance: the image is the convex hull of sampled normals.
+// Neighbouring cells are widened a little (by about two tolerances of image) so that their
+// polygons overlap rather than leave cracks where the two sides sampled a shared edge
+// differently. The union of the images, and of their antipodes, is Omega; its boundary lies
+// on the images of the patch boundaries and of the parabolic lines (the folds), as the
+// paper's method says, and the polygon union finds it.
+// ---------------------------------------------------------------------------------------
+
+constexpr double kRegularCellSpread = 0.5;  // radians
+constexpr int kMaxCellDepth = 22;
+
+struct CellImage {
+  std::vector<Vec3> normals;  // the images of the cell's boundary, a loop
+  bool fold = false;          // a fold cell: take the hull of `normals`
+  Vec3 centre;                // the normal at the cell's centre
+  double spread = 0.0;        // largest angle from `centre` to a normal of the cell (sampled)
+  double area = 0.0;          // parameter area, to pick the pole cell
+  const PatchData* patch = nullptr;
+  double u0 = 0.0, u1 = 1.0, v0 = 0.0, v1 = 1.0;
+};
+
+struct Cell {
+  double u0, u1, v0, v1;
+  bool fold;
+  Vec3 centre;
+  double spread;
+};
+
+// Cells of one patch, and the images of their boundaries. Every cell edge is cut at every
+// cell corner that lies on it (the quadtree's T-junctions), and each elementary piece is
+// sampled by a rule that depends only on its two end parameters: two cells sharing an edge
+// then share its image polygon vertex for vertex, and their images meet without cracks or
+// overlaps (which the polygon union handles at little cost).
+struct CellBuilder {
+  const PatchData& data;
+  double tol;
+  std::vector<Cell> cells;
+
+  Vec3 normalAt(double u, double v) const { return unitNormal(*data.patch, u, v); }
+
+  void run() { visit(data.curvature, 0.0, 1.0, 0.0, 1.0, 0); }
+
+  void visit(const Bernstein2& k, double u0, double u1, double v0, double v1, int depth) {
+    const Vec3 centre = normalAt(0.5 * (u0 + u1), 0.5 * (v0 + v1));
+    double spread = 0.0;
+    for (int i = 0; i <= 2; ++i) {
+      for (int j = 0; j <= 2; ++j) {
+        const Vec3 n = normalAt(u0 + 0.5 * i * (u1 - u0), v0 + 0.5 * j * (v1 - v0));
+        spread = std::max(spread, angleBetween(centre, n));
+      }
+    }
+    if (strictSign(k) && spread <= kRegularCellSpread) {
+      cells.push_back({u0, u1, v0, v1, false, centre, spread});
+      return;
+    }
+    if (spread <= tol || depth >= kMaxCellDepth) {
+      cells.push_back({u0, u1, v0, v1, true, centre, spread});
+      return;
+    }
+    const double um = 0.5 * (u0 + u1);
+    const double vm = 0.5 * (v0 + v1);
+    auto [left, right] = subdivideU(k, 0.5);
+    auto [ll, lr] = subdivideV(left, 0.5);
+    auto [rl, rr] = subdivideV(right, 0.5);
+    visit(ll, u0, um, v0, vm, depth + 1);
+    visit(lr, u0, um, vm, v1, depth + 1);
+    visit(rl, um, u1, v0, vm, depth + 1);
+    visit(rr, um, u1, vm, v1, depth + 1);
+  }
+
+  // Normals along the segment from (ua, va) to (ub, vb) (a piece of a cell edge), without
+  // its last point, sampled to the tolerance by halving (deterministic in the end points).
+  void sampleEdge(double ua, double va, double ub, double vb, std::vector<Vec3>& out) const {
+    auto at = [&](double s) { return normalAt(ua + s * (ub - ua), va + s * (vb - va)); };
+    const Vec3 n0 = at(0.0);
+    std::vector<Vec3> piece{n0};
+    sampleNormals(at, 0.0, 1.0, n0, at(1.0), tol, std::max(64.0 * tol, 0.05), 0, piece);
+    out.insert(out.end(), piece.begin(), piece.end() - 1);
+  }
+
+  std::vector<CellImage> images() const {
+    // Corners on every vertical line u = c and horizontal line v = c (dyadic: exact keys).
+    std::map<double, std::vector<double>> onU;  // u -> v's of corners
+    std::map<double, std::vector<double>> onV;  // v -> u's of corners
+    for (const Cell& c : cells) {
+      for (double u : {c.u0, c.u1}) {
+        for (double v : {c.v0, c.v1}) onU[u].push_back(v), onV[v].push_back(u);
+      }
+    }
+    for (auto* index : {&onU, &onV}) {
+      for (auto& [unused, values] : *index) {
+        std::sort(values.begin(), values.end());
+        values.erase(std::unique(values.begin(), values.end()), values.end());
+      }
+    }
+    // The cut points of [a, b] on a line, increasing.
+    auto cuts = [](const std::vector<double>& values, double a, double b) {
+      std::vector<double> out;
+      for (auto it = std::lower_bound(values.begin(), values.end(), a);
+           it != values.end() && *it <= b; ++it) {
+        out.push_back(*it);
+      }
+      return out;
+    };
+    std::vector<CellImage> out;
+    for (const Cell& c : cells) {
+      CellImage image;
+      image.fold = c.fold;
+      image.centre = c.centre;
+      image.area = (c.u1 - c.u0) * (c.v1 - c.v0);
+      image.spread = c.spread;
+      image.patch = &data;
+      image.u0 = c.u0, image.u1 = c.u1, image.v0 = c.v0, image.v1 = c.v1;
+      auto& loop = image.normals;
+      // Bottom (v = v0, u up), right (u = u1, v up), top (v = v1, u down), left (u = u0, v
+      // down); each elementary piece sampled in increasing parameter, reversed as needed.
+      auto forward = [&](const std::vector<double>& ts, bool alongU, double fixed) {
+        for (std::size_t i = 0; i + 1 < ts.size(); ++i) {
+          if (alongU) sampleEdge(ts[i], fixed, ts[i + 1], fixed, loop);
+          else sampleEdge(fixed, ts[i], fixed, ts[i + 1], loop);
+        }
+      };
+      auto backward = [&](const std::vector<double>& ts, bool alongU, double fixed) {
+        for (std::size_t i = ts.size() - 1; i > 0; --i) {
+          std::vector<Vec3> piece;
+          if (alongU) sampleEdge(ts[i - 1], fixed, ts[i], fixed, piece);
+          else sampleEdge(fixed, ts[i - 1], fixed, ts[i], piece);
+          // piece holds [t_{i-1}, t_i) in increasing order: emit t_i down to t_{i-1}.
+          piece.push_back(alongU ? normalAt(ts[i], fixed) : normalAt(fixed, ts[i]));
+          for (std::size_t j = piece.size() - 1; j > 0; --j) loop.push_back(piece[j]);
+        }
+      };
+      forward(cuts(onV.at(c.v0), c.u0, c.u1), true, c.v0);
+      forward(cuts(onU.at(c.u1), c.v0, c.v1), false, c.u1);
+      backward(cuts(onV.at(c.v1), c.u0, c.u1), true, c.v1);
+      backward(cuts(onU.at(c.u0), c.v0, c.v1), false, c.u0);
+      out.push_back(std::move(image));
+    }
+    return out;
+  }
+};
+
+namespace bp = boost::polygon;
+using IntPoint = bp::point_data<int>;
+using IntPolygon = bp::polygon_data<int>;
+using IntPolygonWithHoles = bp::polygon_with_holes_data<int>;
+using IntPolygonSet = bp::polygon_set_data<int>;
+
+// Andrew's monotone chain: the convex hull of a point set, counter-clockwise.
+std::vector<Vec2> convexHull(std::vector<Vec2> points) {
+  std::sort(points.begin(), points.end(),
+            [](const Vec2& a, const Vec2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
+  if (points.size() < 3) return points;
+  std::vector<Vec2> hull(2 * points.size());
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    while (k >= 2 && cross(hull[k - 1] - hull[k - 2], points[i] - hull[k - 2]) <= 0.0) --k;
+    hull[k++] = points[i];
+  }
+  for (std::size_t i = points.size() - 1, t = k + 1; i-- > 0;) {
+    while (k >= t && cross(hull[k - 1] - hull[k - 2], points[i] - hull[k - 2]) <= 0.0) --k;
+    hull[k++] = points[i];
+  }
+  hull.resize(k - 1);
+  return hull;
+}
+
+}  // namespace
+
+bool isSymmetrizedNormal(const Surface& surface, const Vec3& direction) {
+  std::vector<PatchData> patches;
+  for (const BezierPatch& p : surface.patches) patches.push_back(makePatchData(p));
+  return inOmega(patches, normalized(direction));
+}
+
+GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& options) {
+  const double tol = options.toleranceRad;
+  if (!(tol > 0.0) || !std::isfinite(tol)) {
+    throw Error(fmt::format("the Gauss map tolerance must be a positive angle, got {} rad", tol));
+  }
+  if (surface.patches.empty()) throw Error("the surface has no patches");
+  GaussMap map;
+  std::vector<PatchData> patches;
+  for (const BezierPatch& p : surface.patches) patches.push_back(makePatchData(p));
+
+  // Cell images of every patch (a developable patch has no regular cell: its image is the
+  // image of its boundary, a curve).
+  std::vector<CellImage> cells;
+  int foldCells = 0;
+  bool allDevelopable = true;
+  std::vector<std::vector<Vec3>> developableCurves;
+  for (const PatchData& data : patches) {
+    if (data.developable) {
+      const BezierPatch& patch = *data.patch;
+      const std::array<std::function<Vec3(double)>, 4> edges{
+          [&](double s) { return unitNormal(patch, s, 0.0); },
+          [&](double s) { return unitNormal(patch, 1.0, s); },
+          [&](double s) { return unitNormal(patch, 1.0 - s, 1.0); },
+          [&](double s) { return unitNormal(patch, 0.0, 1.0 - s); }};
+      for (const auto& edge : edges) developableCurves.push_back(normalCurve(edge, tol));
+      continue;
+    }
+    allDevelopable = false;
+    CellBuilder builder{data, tol, {}};
+    builder.run();
+    for (const Cell& c : builder.cells) foldCells += c.fold ? 1 : 0;
+    for (auto& c : builder.images()) cells.push_back(std::move(c));
+  }
+  map.parabolicCurves = static_cast<std::size_t>(foldCells);
+
+  // All normals within the tolerance of one direction: a plane.
+  const Vec3 first = unitNormal(surface.patches.front(), 0.5, 0.5);
+  double spread = 0.0;
+  for (const CellImage& c : cells) {
+    for (const Vec3& n : c.normals) spread = std::max(spread, angleBetween(first, n));
+  }
+  for (const auto& curve : developableCurves) {
+    for (const Vec3& n : curve) spread = std::max(spread, angleBetween(first, n));
+  }
+  if (spread <= tol) {
+    map.kind = GaussMapKind::point;
+    map.pole = first;
+    map.toPoleFrame = rotationTaking(first, {0.0, 0.0, 1.0});
+    map.sphereCurves = {{first}, {-first}};
+    return map;
+  }
+  if (allDevelopable) {
+    map.kind = GaussMapKind::curve;
+    map.pole = first;
+    map.toPoleFrame = rotationTaking(first, {0.0, 0.0, 1.0});
+    for (const auto& curve : developableCurves) {
+      map.sphereCurves.push_back(curve);
+      std::vector<Vec3> opposite;
+      for (const Vec3& n : curve) opposite.push_back(-n);
+      map.sphereCurves.push_back(std::move(opposite));
+    }
+    return map;
+  }
+  // TODO(developable patches among curved ones): their curves are not yet in Omega.
+
+  // The pole cell: the regular cell of largest parameter area; the pole is its centre
+  // normal, inside its image, so that image is the outside of its boundary's projection.
+  std::size_t poleCell = cells.size();
+  for (std::size_t i = 0; i < cells.size(); ++i) {
+    if (!cells[i].fold && (poleCell == cells.size() || cells[i].area > cells[poleCell].area)) {
+      poleCell = i;
+    }
+  }
+  if (poleCell == cells.size()) throw Error("the Gauss map has no regular cell (K = 0 almost everywhere)");
+  map.pole = cells[poleCell].centre;
+  map.toPoleFrame = rotationTaking(map.pole, {0.0, 0.0, 1.0});
+  const Rotation3 back = transpose(map.toPoleFrame);
+
+  auto project = [&](const Vec3& n) { return stereographic(apply(map.toPoleFrame, n)); };
+  // The pole cell's boundary bounds everything else: scale it into the integer grid.
+  std::vector<Vec2> outer;
+  for (const Vec3& n : cells[poleCell].normals) outer.push_back(project(n));
+  double extent = 0.0;
+  for (const Vec2& p : outer) extent = std::max({extent, std::abs(p.x), std::abs(p.y)});
+  const double scale = static_cast<double>(1 << 29) / extent;
+  auto toInt = [&](const Vec2& p) {
+    return IntPoint(static_cast<int>(std::lround(p.x * scale)), static_cast<int>(std::lround(p.y * scale)));
+  };
+  auto toPolygon = [&](const std::vector<Vec2>& loop) {
+    std::vector<IntPoint> points;
+    for (const Vec2& p : loop) {
+      // Images beyond the pole cell's boundary are inside Omega anyway: clamp them there.
+      const Vec2 q = std::abs(p.x) > extent || std::abs(p.y) > extent
+                         ? (extent / std::max(std::abs(p.x), std::abs(p.y))) * p
+                         : p;
+      const IntPoint ip = toInt(q);
+      if (points.empty() || !(points.back() == ip)) points.push_back(ip);
+    }
+    while (points.size() > 1 && points.front() == points.back()) points.pop_back();
+    IntPolygon polygon;
+    polygon.set(points.begin(), points.end());
+    return polygon;
+  };
+
+  using namespace boost::polygon::operators;
+  IntPolygonSet inside;
+  inside.insert(toPolygon(outer));
+  IntPolygonSet omega;
+  const IntPolygon outerPolygon = toPolygon(outer);
+  for (std::size_t i = 0; i < cells.size(); ++i) {
+    const CellImage& c = cells[i];
+    for (double sign : {1.0, -1.0}) {
+      if (i == poleCell && sign > 0.0) continue;
+      std::vector<Vec2> loop;
+      for (const Vec3& n : c.normals) loop.push_back(project(sign * n));
+      if (c.fold) loop = convexHull(std::move(loop));
+      if (loop.size() < 3) continue;
+      // A cell whose image holds the pole (the Gauss map covers the pole more than once) is
+      // the outside of its projected boundary: within the pole cell's loop, that loop's
+      // region minus the cell loop's inside. Decided exactly when the sampled spread leaves
+      // it possible (the cell's sampled normals come within twice their spread of the pole).
+      const Vec3 pole = sign * map.pole;
+      bool holdsPole = false;
+      if (angleBetween(c.centre, pole) <= 2.0 * c.spread + tol) {
+        std::array<Bernstein2, 3> local;
+        for (std::size_t k = 0; k < 3; ++k) {
+          local[k] = restrictTo(c.patch->normal[k], c.u0, c.u1, c.v0, c.v1);
+        }
+        holdsPole = hasNormal(local, pole);
+      }
+      if (holdsPole) {
+        IntPolygonSet ring;
+        ring.insert(outerPolygon);
+        IntPolygonSet cut;
+        cut.insert(toPolygon(loop));
+        IntPolygonSet rest;
+        rest = boost::polygon::operators::operator-(ring, cut);
+        omega.insert(rest);
+      } else {
+        // insert() only collects edges: the union is formed once, by the final difference
+        // (operator+= would clean the whole set at every call, quadratic in the cells).
+        omega.insert(toPolygon(loop));
+      }
+    }
+  }
+  IntPolygonSet complement;
+  complement = boost::polygon::operators::operator-(inside, omega);
+  std::vector<IntPolygonWithHoles> parts;
+  complement.get(parts);
+
+  // Slivers (cracks the overlaps did not close, or rounding) are tiny beside the true
+  // complement: keep the components of at least 1e-6 of the largest area.
+  double largest = 0.0;
+  for (const auto& part : parts) largest = std::max(largest, static_cast<double>(bp::area(part)));
+  auto toLoop = [&](auto begin, auto end) {
+    std::vector<Vec2> loop;
+    for (auto it = begin; it != end; ++it) loop.push_back({it->x() / scale, it->y() / scale});
+    if (loop.size() > 1 && loop.front() == loop.back()) loop.pop_back();
+    return loop;
+  };
+  for (const auto& part : parts) {
+    if (static_cast<double>(bp::area(part)) < 1e-6 * largest) continue;
+    map.loops.push_back(toLoop(part.begin(), part.end()));
+    for (auto hole = part.begin_holes(); hole != part.end_holes(); ++hole) {
+      map.loops.push_back(toLoop(hole->begin(), hole->end()));
+    }
+  }
+  for (const auto& loop : map.loops) {
+    map.boundarySegments += loop.size();
+    std::vector<Vec3> onSphere;
+    for (const Vec2& p : loop) onSphere.push_back(apply(back, inverseStereographic(p)));
+    onSphere.push_back(onSphere.front());
+    map.sphereCurves.push_back(std::move(onSphere));
+  }
+  map.candidatePieces = cells.size();
+  return map;
+}
+
+}  // namespace scallop

@@ -1,0 +1,211 @@
+// End-to-end tests of `scallop orient`: each run happens in a fresh temporary directory;
+// failures must exit non-zero, name the problem, and leave no output file, no temporary and
+// no --svg-dir directory behind; the happy path writes the JSON and both figures, and finds
+// the paper's optimum for test surface #2 (eq 19), an independent reference.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_fixture.hpp"
+#include "scallop/optimal_slicing.hpp"
+
+namespace scallop {
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+using test::readFile;
+using test::RunResult;
+
+class OrientCli : public test::CliFixture {
+ protected:
+  std::vector<std::string> listing(const fs::path& subdirectory) const {
+    std::vector<std::string> names;
+    for (const auto& entry : fs::directory_iterator(workDir_ / subdirectory)) {
+      names.push_back(entry.path().filename().string());
+    }
+    std::sort(names.begin(), names.end());
+    return names;
+  }
+  using test::CliFixture::listing;
+};
+
+// The angle in degrees between the line of `normal` (a JSON [x, y, z]) and that of the
+// paper's N* = (0.975, -0.221, -0.002) for test surface #2, eq (19); +-N* slice alike.
+double degreesFromPaperOptimum(const Json& normal) {
+  const double reference[3] = {0.975, -0.221, -0.002};
+  double dotProduct = 0.0;
+  double normalLength = 0.0;
+  double referenceLength = 0.0;
+  for (std::size_t i = 0; i < 3; ++i) {
+    const double value = normal.at(i).get<double>();
+    dotProduct += value * reference[i];
+    normalLength += value * value;
+    referenceLength += reference[i] * reference[i];
+  }
+  const double cosine = std::abs(dotProduct) / std::sqrt(normalLength * referenceLength);
+  return std::acos(std::min(1.0, cosine)) * 180.0 / std::numbers::pi;
+}
+
+// ---------------------------------------------------------------------------------------
+// Bad input: exit status 1, a message naming the problem, nothing written.
+// ---------------------------------------------------------------------------------------
+
+constexpr const char* kDegenerateSurface =
+    R"({"units": "in", "patches": [{"degree": [1, 1], "control_points": )"
+    R"([[[1, 2, 3], [1, 2, 3]], [[1, 2, 3], [1, 2, 3]]]}]})";
+
+struct BadRun {
+  const char* what;
+  const char* inputName;  // nullptr: no input file is created
+  const char* content;
+  const char* arguments;  // after "orient"; output options are appended
+  std::vector<std::string> messageParts;
+};
+
+const std::vector<BadRun>& badRuns() {
+  static const std::vector<BadRun> runs = {
+      {"tolerance zero", nullptr, "", "--example paper-2 --tolerance 0",
+       {"tolerance", "'0'", "positive"}},
+      {"tolerance negative", nullptr, "", "--example paper-2 --tolerance -1",
+       {"tolerance", "'-1'", "positive"}},
+      {"tolerance not a number", nullptr, "", "--example paper-2 --tolerance abc",
+       {"tolerance", "'abc'"}},
+      {"tolerance too large", nullptr, "", "--example paper-2 --tolerance 10",
+       {"tolerance", "'10'", "below 5"}},
+      {"missing file", nullptr, "", "missing.json --tolerance 1", {"missing.json", "No such file"}},
+      {"malformed JSON", "in.json", R"({"units": "in", "patches": [)", "in.json --tolerance 1",
+       {"in.json", "malformed JSON"}},
+      {"not a surface", "in.json", R"({"units": "in", "patch": []})", "in.json --tolerance 1",
+       {"in.json", "patch"}},
+      {"degenerate patch", "in.json", kDegenerateSurface, "in.json --tolerance 1",
+       {"in.json", "patches[0]", "degenerate"}},
+  };
+  return runs;
+}
+
+TEST_F(OrientCli, BadInputFailsWithMessageAndWritesNothing) {
+  for (const BadRun& bad : badRuns()) {
+    SCOPED_TRACE(bad.what);
+    fs::remove_all(workDir_);
+    fs::create_directory(workDir_);
+    if (bad.inputName != nullptr) write(bad.inputName, bad.content);
+    const RunResult result =
+        run(std::string("orient ") + bad.arguments + " --json out.json --svg-dir figs");
+    EXPECT_EQ(result.exitCode, 1);
+    EXPECT_EQ(result.err.rfind("scallop: error: ", 0), 0u) << result.err;
+    for (const std::string& part : bad.messageParts) {
+      EXPECT_NE(result.err.find(part), std::string::npos)
+          << "stderr '" << result.err << "' lacks '" << part << "'";
+    }
+    EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+    EXPECT_TRUE(result.out.empty()) << result.out;
+    const std::vector<std::string> expected = bad.inputName == nullptr
+                                                  ? std::vector<std::string>{}
+                                                  : std::vector<std::string>{bad.inputName};
+    EXPECT_EQ(listing(), expected);
+  }
+}
+
+TEST_F(OrientCli, UsageErrorsFailWithoutOutput) {
+  write("in.json", kDegenerateSurface);  // never read: every command line here is rejected
+  for (const char* arguments :
+       {"orient --json out.json", "orient in.json --example paper-2 --json out.json",
+        "orient --example nope --json out.json", "orient --example paper-2 --svg-dir -",
+        "orient --example paper-2 --bogus", "orient --example paper-2 --tolerance"}) {
+    SCOPED_TRACE(arguments);
+    const RunResult result = run(arguments);
+    EXPECT_NE(result.exitCode, 0);
+    EXPECT_FALSE(result.err.empty());
+    EXPECT_EQ(listing(), std::vector<std::string>{"in.json"});
+  }
+}
+
+// The JSON cannot be written: the figures are not left behind, nor the directory this run
+// created for them.
+TEST_F(OrientCli, FailedWriteRemovesFiguresAndTheirDirectory) {
+  const RunResult result = run(
+      "orient --example paper-2 --tolerance 1 --no-certify --json nodir/out.json --svg-dir "
+      "figs/nested");
+  EXPECT_EQ(result.exitCode, 1);
+  EXPECT_NE(result.err.find("nodir/out.json"), std::string::npos) << result.err;
+  EXPECT_TRUE(listing().empty());
+}
+
+// ---------------------------------------------------------------------------------------
+// Happy paths
+// ---------------------------------------------------------------------------------------
+
+TEST_F(OrientCli, WritesJsonAndFiguresAndFindsThePapersOptimum) {
+  const RunResult result = run("orient --example paper-2 --json out.json --svg-dir figs");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  EXPECT_TRUE(result.out.empty()) << result.out;
+  EXPECT_EQ(listing(), (std::vector<std::string>{"figs", "out.json"}));
+  EXPECT_EQ(listing("figs"), (std::vector<std::string>{"gauss-map.svg", "stereographic.svg"}));
+
+  // One summary line: N*, alpha*, the certificate, the segments, the time, the outputs.
+  EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+  for (const char* part : {"example paper-2", "N* = (", "alpha* = ", "certified",
+                           "boundary segments", " s -> out.json, figs/gauss-map.svg"}) {
+    EXPECT_NE(result.err.find(part), std::string::npos) << part << " in " << result.err;
+  }
+
+  const Json doc = Json::parse(readFile(workDir_ / "out.json"));
+  EXPECT_LT(degreesFromPaperOptimum(doc.at("normal")), 1.0) << doc.at("normal").dump();
+  EXPECT_EQ(doc.at("method"), "medial-axis");
+  EXPECT_TRUE(doc.at("certified").get<bool>());
+  // The library's default tolerance, in degrees.
+  EXPECT_NEAR(doc.at("tolerance_deg").get<double>(),
+              OptimalSlicingOptions{}.toleranceRad * 180.0 / std::numbers::pi, 1e-9);
+  EXPECT_GT(doc.at("gauss_map").at("boundary_segments").get<std::size_t>(), 0u);
+
+  for (const char* figure : {"figs/gauss-map.svg", "figs/stereographic.svg"}) {
+    const std::string svg = readFile(workDir_ / figure);
+    EXPECT_EQ(svg.rfind("<svg", 0), 0u) << figure;
+    EXPECT_NE(svg.find("</svg>"), std::string::npos) << figure;
+    EXPECT_NE(svg.find("class=\"circle\""), std::string::npos) << figure;
+  }
+}
+
+TEST_F(OrientCli, JsonGoesToStandardOutputByDefault) {
+  const RunResult result = run("orient --example paper-1 --tolerance 1 --no-certify");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  EXPECT_TRUE(result.err.empty()) << result.err;  // no summary when stdout carries the JSON
+  EXPECT_TRUE(listing().empty());
+  const Json doc = Json::parse(result.out);
+  EXPECT_EQ(doc.at("tolerance_deg").get<double>(), 1.0);
+  EXPECT_FALSE(doc.at("certified").get<bool>());
+  EXPECT_EQ(doc.at("certificate_cells").get<std::size_t>(), 0u);
+}
+
+TEST_F(OrientCli, ReadsStandardInputAndCreatesNestedFigureDirectories) {
+  const std::string input =
+      (fs::path(SCALLOP_EXAMPLES_DIR) / "surfaces" / "paper-2.json").string();
+  const RunResult result =
+      run("orient - --tolerance 1 --no-certify --json - --svg-dir out/figs", input);
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  EXPECT_LT(degreesFromPaperOptimum(Json::parse(result.out).at("normal")), 1.0);
+  EXPECT_EQ(listing("out/figs"),
+            (std::vector<std::string>{"gauss-map.svg", "stereographic.svg"}));
+}
+
+TEST_F(OrientCli, Help) {
+  const RunResult help = run("orient --help");
+  EXPECT_EQ(help.exitCode, 0);
+  for (const char* part : {"SURFACE", "--example", "--tolerance", "--json", "--svg-dir",
+                           "--no-certify", "scallop orient"}) {
+    EXPECT_NE(help.out.find(part), std::string::npos) << part;
+  }
+  EXPECT_TRUE(listing().empty());
+}
+
+}  // namespace
+}  // namespace scallop
