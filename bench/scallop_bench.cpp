@@ -13,7 +13,11 @@
 #include <map>
 #include <random>
 
+#include "scallop/gauss_map.hpp"
+#include "scallop/medial_axis.hpp"
+#include "scallop/optimal_slicing.hpp"
 #include "scallop/scallop_hull.hpp"
+#include "scallop/surface.hpp"
 
 namespace {
 
@@ -87,7 +91,55 @@ void BM_BruteForceEnvelope(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * state.range(0));
 }
 
+// Optimal slicing of the paper's surfaces at the default tolerance (0.5 degree), whole
+// pipeline (Gauss map, medial axis, eq 13, polish, certificate), and the Gauss map alone.
+void BM_Orient(benchmark::State& state, const char* name) {
+  const scallop::Surface surface = scallop::exampleSurface(name);
+  for (auto _ : state) {
+    scallop::OptimalSlicing result = scallop::optimalSlicing(surface);
+    benchmark::DoNotOptimize(result.alphaRad);
+  }
+}
+
+void BM_GaussMap(benchmark::State& state, const char* name) {
+  const scallop::Surface surface = scallop::exampleSurface(name);
+  scallop::GaussMapOptions options;
+  options.toleranceRad = 0.5 * 3.14159265358979323846 / 180.0;
+  for (auto _ : state) {
+    scallop::GaussMap map = scallop::symmetrizedGaussMap(surface, options);
+    benchmark::DoNotOptimize(map.boundarySegments);
+  }
+}
+
+// The medial axis (Boost.Polygon's Voronoi diagram, validated) of a wavy annulus with
+// range(0) boundary segments in all: the size the issue asks the pipeline to reach.
+void BM_MedialAxis(benchmark::State& state) {
+  const auto segments = static_cast<std::size_t>(state.range(0));
+  scallop::PlanarDomain domain;
+  for (double radius : {3.0, 1.0}) {
+    std::vector<scallop::Vec2> loop;
+    const std::size_t n = segments / 2;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double t = 2.0 * 3.14159265358979323846 * static_cast<double>(i) / static_cast<double>(n);
+      const double r = radius * (1.0 + 0.05 * std::sin(7.0 * t));
+      loop.push_back({r * std::cos(t), r * std::sin(t)});
+    }
+    domain.loops.push_back(std::move(loop));
+  }
+  for (auto _ : state) {
+    scallop::MedialAxis axis = scallop::medialAxis(domain);
+    benchmark::DoNotOptimize(axis.edges.data());
+  }
+  state.SetItemsProcessed(state.iterations() * state.range(0));
+}
+
 }  // namespace
+
+BENCHMARK_CAPTURE(BM_Orient, paper1, "paper-1")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Orient, paper2, "paper-2")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_GaussMap, paper1, "paper-1")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_GaussMap, paper2, "paper-2")->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_MedialAxis)->Arg(1000)->Arg(10000)->Arg(100000)->Unit(benchmark::kMillisecond);
 
 BENCHMARK(BM_ScallopHull)->RangeMultiplier(2)->Range(1 << 10, 1 << 23)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_UpperHull)->RangeMultiplier(2)->Range(1 << 10, 1 << 23)->Unit(benchmark::kMillisecond);
