@@ -44,16 +44,15 @@ constexpr std::int64_t kGridLimit = std::int64_t{1} << 29;
 constexpr double kRebuildStep = std::numbers::sqrt2 - 1.0;
 // Edges shorter than this (grid steps) carry no geometry beyond the tolerance: dropped.
 constexpr double kShortEdge = 1e-3;
-// A side test within this (grid steps) of zero is undecided. Boost's vertices are within
-// 128 ulps of 2^29, i.e. ~1.5e-5 steps, so genuine interior points are far beyond it.
+// A side test within this (grid steps) of zero is undecided. Boost's vertex coordinates
+// are computed to a fixed relative precision (its own diagram treats vertices within 128
+// ulps as one: ~1.5e-5 steps at 2^29), so genuine interior points are far beyond it.
 constexpr double kSideEps = 1e-3;
 // The sample of checkMedialAxis may be this many tolerances from the boundary before the
 // search gives up (the clearance is then known to exceed the radius by too much).
 constexpr double kSearchSlack = 4.0;
 
 double sq(double v) { return v * v; }
-
-
 
 Vec2 unit(Vec2 v) {
   const double n = norm(v);

@@ -33,15 +33,20 @@
 //         reflex vertices, on which nothing of the MAT changes), and edges shorter than
 //         1e-3 q. Edges come in Boost's order (deterministic for a given input and options).
 //         Control points and radii are in the caller's units and frame.
-// Time:   O(n log n) for n boundary segments (Boost's sweep line, the O(n log n) intersection
-//         and orientation checks and the validation with a bounding-volume hierarchy);
-//         O(n) memory. About 0.5 s for 100,000 segments (see tests/medial_axis_test.cpp).
+// Time:   O(n log n) for n boundary segments (Boost's sweep line, the intersection and
+//         orientation checks, and the validation with a bounding-volume hierarchy); O(n)
+//         memory. 100,000 segments sampling two circles: ~2.5 s of CPU on the development
+//         machine, 70-80% of it in Boost's sweep, whose multiprecision fallback serves most
+//         circle events of finely sampled curves (nearly parallel consecutive segments);
+//         two exactly regular 50,000-gons (nearly cocircular vertices) or a wavy annulus of
+//         the same size ~3.5 s.
 //
 // Integer scaling (Boost's input must be integral; its docs state the 32-bit range)
 // ------------------------------------------------------------------------------------
 // The domain is rotated (MedialAxisOptions::rotationRad, about its bounding-box centre),
 // its bounding box is centred on the origin and scaled so that its larger half-side is
-// 2^29 grid steps, and every point is rounded to the nearest integer. The grid step
+// 2^29 grid steps, and every point is rounded to the nearest integer (with
+// MedialAxisOptions::gridStep > 0: rotation about the origin and that step instead). The step
 // q = (larger half-side) / 2^29 ~ 1.9e-9 of the domain's size; 2^29 rather than 2^31 keeps
 // every orientation test of the checks exact in 64-bit integers. Rounding moves every
 // boundary point by at most q / sqrt(2), so the medial axis built is that of a domain within
@@ -49,26 +54,30 @@
 // sites (the rounded features mapped back to the caller's frame), and
 //     |radiusAt(e, t) - clearance(domain, pointAt(e, t))| <= MedialAxis::tolerance = q,
 // the 0.29 q beyond the rounding covering floating-point error (~1e-14 of the domain's size)
-// and Boost's vertex error (at most 128 ulps of a coordinate). Points of the medial axis lie
+// and Boost's vertex error (a fixed relative precision: its own diagram merges vertices
+// within 128 ulps, ~1.5e-5 q). Points of the medial axis lie
 // inside the domain or within the tolerance of its boundary.
 //
 // Validation and rebuilds (Boost's known failures)
 // ------------------------------------------------
-// Boost.Polygon's Voronoi builder has rare, documented failures on valid integer input:
-// missing vertices and edges (boostorg/polygon#43: a six-point polygon, reproduced here with
-// Boost 1.74; #32, #72) and a hang (#49: an endless loop in voronoi_diagram::_build() while
-// removing degenerate vertices, on 1,912 segments given as doubles, against the integer
-// contract). Here:
-//  - the hang cannot occur: the sweep line (which always terminates: each step consumes a
-//    site or removes an arc) feeds a small edge recorder of this module instead of
-//    boost::polygon::voronoi_diagram, so _build()'s rot_next walks never run; and the input
-//    meets Boost's contract (integers, no zero-length segments, no touching or crossing
-//    segments, no repeated points), which the reported inputs did not;
+// Boost.Polygon's Voronoi builder has rare, reported failures: a missing vertex and wrong
+// edges on valid integer input (boostorg/polygon#43, open: a six-point polygon, reproduced
+// here with Boost 1.74 and replayed by the tests), an infinite edge starting inside a closed
+// polygon (#72, open), and a hang (#49, open: an endless loop in voronoi_diagram::_build()
+// while it removes degenerate vertices, on 1,912 segments passed as doubles, outside the
+// integer contract; removing any one segment avoids it). #32 ("diagram broken") turned out
+// to be touching segments, i.e. invalid input. Here:
+//  - the hang cannot occur: the sweep line feeds a small edge recorder of this module
+//    instead of boost::polygon::voronoi_diagram, so _build()'s rot_next walks never run
+//    (the sweep itself terminates: every step consumes a site event or a circle event, and
+//    circle events are only created with new arcs); and the input meets Boost's contract
+//    (integers, no zero-length segments, no touching or crossing segments);
 //  - every diagram is validated before use: each edge's two sites agree on which side of
 //    the boundary it lies; no infinite edge starts strictly inside; no vertex inside the
-//    domain is a dead end; at t = 0, 1/2, 1 of every kept edge the point lies inside the
-//    domain and its radius equals its clearance from the input boundary, computed
-//    independently of Boost (checkMedialAxis); the medial axis is not empty. On failure the
+//    domain is a dead end; the medial axis has one connected piece per component of the
+//    domain (one per loop at even nesting depth); at t = 0, 1/2, 1 of every kept edge the
+//    point lies inside the domain and its radius equals its clearance from the input
+//    boundary, computed independently of Boost (checkMedialAxis). On failure the
 //    input is rotated by a further sqrt(2) - 1 rad (incommensurable with pi/2, so axis-
 //    aligned input never returns to the axes), quantised again and rebuilt, up to
 //    maxRebuilds times; then scallop::Error explains the last failure.
