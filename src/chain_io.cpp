@@ -1,3 +1,4 @@
+#include "input_file.hpp"
 #include "scallop/chain_io.hpp"
 
 #include <algorithm>
@@ -284,37 +285,6 @@ bool looksLikeJson(std::string_view content) {
 // Reading files
 // ---------------------------------------------------------------------------------------
 
-std::string readStream(std::FILE* stream, const std::string& name) {
-  std::string content;
-  char buffer[1 << 16];
-  std::size_t count = 0;
-  errno = 0;
-  while ((count = std::fread(buffer, 1, sizeof buffer, stream)) > 0) {
-    content.append(buffer, count);
-  }
-  if (std::ferror(stream) != 0) {
-    throw Error(fmt::format("cannot read '{}': {}", name, std::strerror(errno != 0 ? errno : EIO)));
-  }
-  return content;
-}
-
-std::string readWholeFile(const std::string& path) {
-  if (path == "-") return readStream(stdin, displayName(path));
-  errno = 0;
-  std::FILE* file = std::fopen(path.c_str(), "rb");
-  if (file == nullptr) {
-    throw Error(
-        fmt::format("cannot open '{}': {}", path, std::strerror(errno != 0 ? errno : ENOENT)));
-  }
-  try {
-    std::string content = readStream(file, path);
-    std::fclose(file);
-    return content;
-  } catch (...) {
-    std::fclose(file);
-    throw;
-  }
-}
 
 // ---------------------------------------------------------------------------------------
 // Built-in examples
@@ -390,7 +360,7 @@ Chain parseChain(std::string_view content, const std::string& sourceName) {
   return chain;
 }
 
-Chain readChain(const std::string& path) { return parseChain(readWholeFile(path), path); }
+Chain readChain(const std::string& path) { return parseChain(detail::readInputFile(path), path); }
 
 std::vector<std::string> exampleChainNames() {
   std::vector<std::string> names;

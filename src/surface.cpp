@@ -1,3 +1,4 @@
+#include "input_file.hpp"
 #include "scallop/surface.hpp"
 
 #include <algorithm>
@@ -489,35 +490,6 @@ Surface parseDocument(const Json& document, const std::string& source) {
 // Reading files
 // ---------------------------------------------------------------------------------------
 
-std::string readStream(std::FILE* stream, const std::string& name) {
-  std::string content;
-  char buffer[1 << 16];
-  std::size_t count = 0;
-  errno = 0;
-  while ((count = std::fread(buffer, 1, sizeof buffer, stream)) > 0) content.append(buffer, count);
-  if (std::ferror(stream) != 0) {
-    throw Error(fmt::format("cannot read '{}': {}", name, std::strerror(errno != 0 ? errno : EIO)));
-  }
-  return content;
-}
-
-std::string readWholeFile(const std::string& path) {
-  if (path == "-") return readStream(stdin, displayName(path));
-  errno = 0;
-  std::FILE* file = std::fopen(path.c_str(), "rb");
-  if (file == nullptr) {
-    throw Error(
-        fmt::format("cannot open '{}': {}", path, std::strerror(errno != 0 ? errno : ENOENT)));
-  }
-  try {
-    std::string content = readStream(file, path);
-    std::fclose(file);
-    return content;
-  } catch (...) {
-    std::fclose(file);
-    throw;
-  }
-}
 
 // ---------------------------------------------------------------------------------------
 // Built-in examples: the paper's Section 4
@@ -608,7 +580,7 @@ Surface parseSurface(std::string_view json, const std::string& sourceName) {
   return surface;
 }
 
-Surface readSurface(const std::string& path) { return parseSurface(readWholeFile(path), path); }
+Surface readSurface(const std::string& path) { return parseSurface(detail::readInputFile(path), path); }
 
 std::string surfaceToJson(const Surface& surface) {
   std::string out =
