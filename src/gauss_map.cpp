@@ -10,6 +10,7 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <tuple>
 #include <unordered_map>
 #include <fmt/format.h>
 #include <boost/polygon/polygon.hpp>
@@ -243,6 +244,7 @@ struct CellImage {
   double area = 0.0;          // parameter area, to pick the pole cell
   const PatchData* patch = nullptr;
   double u0 = 0.0, u1 = 1.0, v0 = 0.0, v1 = 1.0;
+  int curvatureSign = 0;      // regular cells: the sign of K (cells of one sign form a sheet)
 };
 
 struct Cell {
@@ -250,6 +252,7 @@ struct Cell {
   bool fold;
   Vec3 centre;
   double spread;
+  int curvatureSign;  // regular cells: the sign of K on the cell
 };
 
 // Cells of one patch, and the images of their boundaries. Every cell edge is cut at every
@@ -276,11 +279,11 @@ struct CellBuilder {
       }
     }
     if (strictSign(k) && spread <= kRegularCellSpread) {
-      cells.push_back({u0, u1, v0, v1, false, centre, spread});
+      cells.push_back({u0, u1, v0, v1, false, centre, spread, bounds(k).lo > 0.0 ? 1 : -1});
       return;
     }
     if (spread <= tol || depth >= kMaxCellDepth) {
-      cells.push_back({u0, u1, v0, v1, true, centre, spread});
+      cells.push_back({u0, u1, v0, v1, true, centre, spread, 0});
       return;
     }
     const double um = 0.5 * (u0 + u1);
@@ -336,6 +339,7 @@ struct CellBuilder {
       image.area = (c.u1 - c.u0) * (c.v1 - c.v0);
       image.spread = c.spread;
       image.patch = &data;
+      image.curvatureSign = c.curvatureSign;
       image.u0 = c.u0, image.u1 = c.u1, image.v0 = c.v0, image.v1 = c.v1;
       auto& loop = image.normals;
       // Bottom (v = v0, u up), right (u = u1, v up), top (v = v1, u down), left (u = u0, v
@@ -389,6 +393,85 @@ std::vector<Vec2> convexHull(std::vector<Vec2> points) {
   }
   hull.resize(k - 1);
   return hull;
+}
+
+// Twice the signed area of an integer loop (positive counter-clockwise), in double.
+double signedArea2(const std::vector<IntPoint>& loop) {
+  double sum = 0.0;
+  for (std::size_t i = 0; i < loop.size(); ++i) {
+    const IntPoint& a = loop[i];
+    const IntPoint& b = loop[(i + 1) % loop.size()];
+    sum += static_cast<double>(a.x()) * b.y() - static_cast<double>(b.x()) * a.y();
+  }
+  return sum;
+}
+
+// The union of one sheet's cell polygons (all of one orientation, sharing vertices exactly):
+// the directed edges left after each edge met in both directions cancels, walked into loops;
+// each loop with its flag "hole" (orientation opposite to the cells').
+std::vector<std::pair<IntPolygon, bool>> mergeSheet(const std::vector<IntPolygon>& cells) {
+  struct Key {
+    long long ax, ay, bx, by;
+    bool operator==(const Key&) const = default;
+  };
+  struct Hash {
+    std::size_t operator()(const Key& k) const {
+      std::size_t h = std::hash<long long>()(k.ax);
+      for (long long v : {k.ay, k.bx, k.by}) h = h * 1000003u ^ std::hash<long long>()(v);
+      return h;
+    }
+  };
+  std::unordered_map<Key, int, Hash> count;
+  double orientation = 0.0;
+  for (const IntPolygon& polygon : cells) {
+    const std::vector<IntPoint> points(polygon.begin(), polygon.end());
+    orientation += signedArea2(points);
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const IntPoint& a = points[i];
+      const IntPoint& b = points[(i + 1) % points.size()];
+      if (a == b) continue;
+      const Key reverse{b.x(), b.y(), a.x(), a.y()};
+      auto it = count.find(reverse);
+      if (it != count.end() && it->second > 0) {
+        if (--it->second == 0) count.erase(it);
+      } else {
+        ++count[Key{a.x(), a.y(), b.x(), b.y()}];
+      }
+    }
+  }
+  // Walk the remaining edges into loops.
+  std::unordered_map<long long, std::vector<IntPoint>> next;
+  auto id = [](const IntPoint& p) { return (static_cast<long long>(p.x()) << 32) ^ static_cast<unsigned int>(p.y()); };
+  for (const auto& [k, n] : count) {
+    for (int i = 0; i < n; ++i) {
+      next[id(IntPoint(static_cast<int>(k.ax), static_cast<int>(k.ay)))].push_back(
+          IntPoint(static_cast<int>(k.bx), static_cast<int>(k.by)));
+    }
+  }
+  std::vector<std::pair<IntPolygon, bool>> out;
+  for (auto& [start, targets] : next) {
+    while (!targets.empty()) {
+      std::vector<IntPoint> loop;
+      IntPoint from = targets.back();
+      targets.pop_back();
+      // `from` is the second point of an edge leaving `start`; follow until back at start.
+      loop.push_back(from);
+      for (std::size_t guard = 0; guard < count.size() * 2 + 8; ++guard) {
+        auto it = next.find(id(from));
+        if (it == next.end() || it->second.empty()) break;
+        from = it->second.back();
+        it->second.pop_back();
+        loop.push_back(from);
+        if (id(from) == start) break;
+      }
+      if (loop.size() < 3) continue;
+      IntPolygon polygon;
+      polygon.set(loop.begin(), loop.end());
+      const bool hole = (signedArea2(loop) > 0.0) != (orientation > 0.0);
+      out.push_back({std::move(polygon), hole});
+    }
+  }
+  return out;
 }
 
 }  // namespace
@@ -508,6 +591,11 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
   inside.insert(toPolygon(outer));
   IntPolygonSet omega;
   const IntPolygon outerPolygon = toPolygon(outer);
+  // Regular cells of one patch with one sign of K map with one orientation and share their
+  // image vertices exactly with their neighbours (see CellBuilder): their union is the chain
+  // left when every edge shared by two of them (traversed once each way) cancels. Handing
+  // Boost those few loops instead of thousands of cells makes the union cheap.
+  std::map<std::tuple<const PatchData*, int, int>, std::vector<IntPolygon>> sheets;
   for (std::size_t i = 0; i < cells.size(); ++i) {
     const CellImage& c = cells[i];
     for (double sign : {1.0, -1.0}) {
@@ -529,6 +617,11 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
         }
         holdsPole = hasNormal(local, pole);
       }
+      if (!holdsPole && !c.fold) {
+        // Merged below with the other cells of its sheet.
+        sheets[{c.patch, c.curvatureSign, sign > 0.0 ? 1 : -1}].push_back(toPolygon(loop));
+        continue;
+      }
       if (holdsPole) {
         IntPolygonSet ring;
         ring.insert(outerPolygon);
@@ -544,8 +637,15 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
       }
     }
   }
+  for (const auto& [unused, polygons] : sheets) {
+    for (const auto& [loop, hole] : mergeSheet(polygons)) omega.insert(loop, hole);
+  }
   IntPolygonSet complement;
   complement = boost::polygon::operators::operator-(inside, omega);
+  // Parts of the complement may touch at a vertex (two sheets meeting at a point); the
+  // medial axis needs disjoint loops. Shrinking by two grid steps (about 1e-8 of the
+  // domain) separates them and moves the boundary by far less than the tolerance.
+  complement.resize(-2);
   std::vector<IntPolygonWithHoles> parts;
   complement.get(parts);
 
