@@ -14,6 +14,7 @@
 #include "scallop/bezier.hpp"
 #include "scallop/error.hpp"
 #include "scallop/medial_axis.hpp"
+#include "scallop/vector.hpp"
 
 namespace scallop {
 namespace {
@@ -190,6 +191,58 @@ double largest(const std::vector<Contact>& contacts) {
   return best;
 }
 
+// Unit steps in the tangent plane at m (basis e1, e2) that lower the largest of the
+// linearised active contacts f_i(m + d) ~ c_i + g_i . d, with g_i = sign(n_i . m) (n_i . e1,
+// n_i . e2) (the contact point's own motion is second order: it is a local maximum). For
+// each contact alone, its steepest descent; for each pair, the two directions along which
+// the pair stays level (d . (g_i - g_j) = 0) pointing downhill; for each triple, the
+// direction towards the point where all three are level. Only those that lower the
+// linearised maximum are kept.
+std::vector<Vec3> minimaxDirections(const std::vector<Contact>& contacts, const Vec3& m,
+                                    const Vec3& e1, const Vec3& e2, double top) {
+  struct Linear {
+    double c;
+    Vec2 g;
+  };
+  std::vector<Linear> lin;
+  for (const Contact& contact : contacts) {
+    const Vec3 n = unitNormal(*contact.patch, contact.u, contact.v);
+    const double sign = dot(n, m) >= 0.0 ? 1.0 : -1.0;
+    if (contact.value >= top - 1e-6) lin.push_back({contact.value, {sign * dot(n, e1), sign * dot(n, e2)}});
+  }
+  std::vector<Vec2> candidates;
+  for (std::size_t i = 0; i < lin.size(); ++i) {
+    if (norm(lin[i].g) > 0.0) candidates.push_back(-(1.0 / norm(lin[i].g)) * lin[i].g);
+    for (std::size_t j = i + 1; j < lin.size(); ++j) {
+      const Vec2 diff = lin[i].g - lin[j].g;
+      if (norm(diff) == 0.0) continue;
+      const Vec2 along{-diff.y / norm(diff), diff.x / norm(diff)};
+      candidates.push_back(along);
+      candidates.push_back(-along);
+      for (std::size_t k = j + 1; k < lin.size(); ++k) {
+        // g_i . d + c_i = g_j . d + c_j = g_k . d + c_k: two linear equations in d.
+        const Vec2 a = lin[i].g - lin[j].g;
+        const Vec2 b = lin[i].g - lin[k].g;
+        const double det = cross(a, b);
+        if (det == 0.0) continue;
+        const double ra = lin[j].c - lin[i].c;
+        const double rb = lin[k].c - lin[i].c;
+        const Vec2 d{(ra * b.y - rb * a.y) / det, (a.x * rb - b.x * ra) / det};
+        if (norm(d) > 0.0) candidates.push_back((1.0 / norm(d)) * d);
+      }
+    }
+  }
+  std::vector<Vec3> out;
+  for (const Vec2& d : candidates) {
+    double worst = -1.0;
+    for (const Linear& l : lin) worst = std::max(worst, l.c + 1e-3 * dot(l.g, d));
+    double now = -1.0;
+    for (const Linear& l : lin) now = std::max(now, l.c);
+    if (worst < now) out.push_back(d.x * e1 + d.y * e2);
+  }
+  return out;
+}
+
 // Polishes a direction found on the polygonal Gauss map against the true surface: a
 // pattern search on the sphere minimising the largest |n . m| (maximising the minimum angle
 // alpha), from steps of the Gauss-map tolerance down to 1e-10 rad. The medial axis has put
@@ -198,6 +251,7 @@ double largest(const std::vector<Contact>& contacts) {
 // they were, with small steps); a full search at the end checks that no other maximum has
 // overtaken them, and polishing resumes if one has.
 Vec3 polishDirection(const Surface& surface, Vec3 m, double initialStep, double& value) {
+  constexpr double finalStep = 1e-10;
   for (int pass = 0; pass < 8; ++pass) {
     std::vector<Contact> all = findContacts(surface, m);
     const double top = largest(all);
@@ -211,13 +265,21 @@ Vec3 polishDirection(const Surface& surface, Vec3 m, double initialStep, double&
       return largest(cs);
     };
     value = top;
-    for (double step = initialStep; step > 1e-10; step *= 0.5) {
+    for (double step = initialStep; step > finalStep; step *= 0.5) {
       for (int rounds = 0; rounds < 64; ++rounds) {
         const Vec3 e1 = orthogonal(m);
         const Vec3 e2 = cross(m, e1);
         bool moved = false;
+        // Trial steps: the minimax steps of the linearised active contacts (below), then
+        // eight fixed directions. At a point where two or three contacts are level, the
+        // descent cone can be narrower than the fixed directions' spacing: the minimax steps
+        // find it.
+        std::vector<Vec3> directions = minimaxDirections(active, m, e1, e2, value);
         for (const Vec3& d : {e1, -e1, e2, -e2, normalized(e1 + e2), normalized(e1 - e2),
                               normalized(-e1 + e2), normalized(-e1 - e2)}) {
+          directions.push_back(d);
+        }
+        for (const Vec3& d : directions) {
           const Vec3 candidate = normalized(m + step * d);
           std::vector<Contact> trial = active;
           const double f = evaluate(candidate, trial);
@@ -289,6 +351,7 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
   const GaussMap& map = result.gaussMap;
   result.pole = map.pole;
   const Rotation3 back = transpose(map.toPoleFrame);
+  std::vector<Vec3> rivals;  // medial-axis directions to polish (the best first)
 
   if (map.kind == GaussMapKind::point) {
     // A plane: every direction in the plane of the surface is at 90 degrees.
@@ -314,6 +377,7 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
     result.medialAxisEdges = axis.edges.size();
     result.medialAxisRebuilds = axis.rebuilds;
     double bestAlpha = -1.0;
+    std::vector<std::pair<double, PlaneCircle>> circles;  // every candidate, for rival basins
     for (const MedialEdge& edge : axis.edges) {
       std::vector<Vec2> curve;
       const int samples = edge.kind == MedialEdge::Kind::linear ? 1 : 8;
@@ -330,6 +394,7 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
         // in the complement; the medial axis never yields them but rounding might.
         if (!(r > 0.0) || rho <= r) continue;
         const double alpha = alphaOfPlaneCircleRad(rho, r);  // eq (12)
+        circles.push_back({alpha, {c, r}});
         if (alpha > bestAlpha) bestAlpha = alpha, result.circle = {c, r};
       }
     }
@@ -337,15 +402,35 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
     result.alphaRad = alphaOfPlaneCircleRad(norm(result.circle.center), result.circle.radius);
     result.normal = apply(back, directionOfPlaneCircle(result.circle.center, result.circle.radius));
     result.sphereCircle = {result.normal, result.alphaRad};
+    // Rival basins: the polygon is within tol of Omega, so a circle within a few tol of the
+    // best may be the true optimum's. Keep up to four such, in distinct directions (more
+    // than a degree apart), to be polished below.
+    std::sort(circles.begin(), circles.end(),
+              [](const auto& a, const auto& b) { return a.first > b.first; });
+    for (const auto& [alpha, circle] : circles) {
+      if (alpha < bestAlpha - 4.0 * tol || rivals.size() >= 4) break;
+      const Vec3 n = apply(back, directionOfPlaneCircle(circle.center, circle.radius));
+      bool distinct = true;
+      for (const Vec3& q : rivals) {
+        distinct = distinct && std::acos(std::min(1.0, std::abs(dot(q, n)))) > std::numbers::pi / 180.0;
+      }
+      if (distinct) rivals.push_back(n);
+    }
   }
   // Polish against the true surface (see polishDirection); the circle found on the
   // polygonal map stays as the medial-axis result.
   // (A curve-like image was searched on its own exact samples; its |n . N| landscape is flat
   // along the family of normals, where the pattern search only wanders.)
   if (result.method == "medial-axis") {
-    double value = 0.0;
-    result.normal = polishDirection(surface, result.normal, tol, value);
-    result.alphaRad = std::acos(std::min(1.0, value));
+    // Every rival is polished to the end: the pattern search crawls along the ridges where
+    // contacts are level, so a ranking after a coarse polish is not reliable.
+    double bestValue = 2.0;
+    for (const Vec3& seed : rivals) {
+      double value = 0.0;
+      const Vec3 polished = polishDirection(surface, seed, tol, value);
+      if (value < bestValue) bestValue = value, result.normal = polished;
+    }
+    result.alphaRad = std::acos(std::min(1.0, bestValue));
     result.sphereCircle = {result.normal, result.alphaRad};
   }
   // Certificate: prove that no normal comes within alpha* less a small margin (what the

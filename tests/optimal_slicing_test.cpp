@@ -191,6 +191,50 @@ TEST(OptimalSlicing, RandomGraphPatchesInchesAndMillimetres) {
   }
 }
 
+TEST(OptimalSlicing, RandomGeneralPatches) {
+  // Control nets that are not grids over the plane: every point moved in x, y and z.
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> jitter(-0.35, 0.35);
+  std::uniform_real_distribution<double> height(0.0, 1.5);
+  int tested = 0;
+  while (tested < 3) {
+    BezierPatch p;
+    for (int j = 0; j <= 3; ++j) {
+      for (int k = 0; k <= 3; ++k) p.control.push_back({k + jitter(rng), j + jitter(rng), height(rng)});
+    }
+    Surface s;
+    s.patches.push_back(p);
+    try {
+      scallop::validateSurface(s);
+    } catch (const scallop::Error&) {
+      continue;  // a net folding over itself: not a regular patch
+    }
+    SCOPED_TRACE("general patch " + std::to_string(tested));
+    expectAsGoodAsBruteForce(s, 0.5);
+    ++tested;
+  }
+}
+
+TEST(OptimalSlicing, TwoPatchSurface) {
+  // Two bicubic patches side by side, sharing their common boundary row (C0): the Gauss map
+  // is the union of both patches' images.
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> height(0.0, 1.2);
+  double z[4][7];
+  for (auto& row : z) {
+    for (double& h : row) h = height(rng);
+  }
+  Surface s;
+  for (int part = 0; part < 2; ++part) {
+    BezierPatch p;
+    for (int j = 0; j <= 3; ++j) {
+      for (int k = 0; k <= 3; ++k) p.control.push_back({double(3 * part + k), double(j), z[j][3 * part + k]});
+    }
+    s.patches.push_back(p);
+  }
+  expectAsGoodAsBruteForce(s, 0.5);
+}
+
 TEST(OptimalSlicing, PlaneAndCylinder) {
   // A plane: alpha* = 90 degrees, N* in the plane.
   Surface plane;

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <numbers>
@@ -40,19 +41,22 @@ class OrientCli : public test::CliFixture {
 
 // The angle in degrees between the line of `normal` (a JSON [x, y, z]) and that of the
 // paper's N* = (0.975, -0.221, -0.002) for test surface #2, eq (19); +-N* slice alike.
+// Angle between `normal` and the paper's N* for surface 2 (eq 19), up to sign and the
+// surface's symmetry: its control net is unchanged by swapping x and y (p_jk <-> p_kj), so
+// (y, x, z) is as optimal as (x, y, z).
 double degreesFromPaperOptimum(const Json& normal) {
-  const double reference[3] = {0.975, -0.221, -0.002};
-  double dotProduct = 0.0;
-  double normalLength = 0.0;
-  double referenceLength = 0.0;
-  for (std::size_t i = 0; i < 3; ++i) {
-    const double value = normal.at(i).get<double>();
-    dotProduct += value * reference[i];
-    normalLength += value * value;
-    referenceLength += reference[i] * reference[i];
+  const double n[3] = {normal.at(0).get<double>(), normal.at(1).get<double>(), normal.at(2).get<double>()};
+  const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  double best = 180.0;
+  for (const auto& reference : {std::array<double, 3>{0.975, -0.221, -0.002},
+                                std::array<double, 3>{-0.221, 0.975, -0.002}}) {
+    const double referenceLength = std::sqrt(reference[0] * reference[0] +
+                                             reference[1] * reference[1] + reference[2] * reference[2]);
+    const double cosine =
+        std::abs(n[0] * reference[0] + n[1] * reference[1] + n[2] * reference[2]) / (length * referenceLength);
+    best = std::min(best, std::acos(std::min(1.0, cosine)) * 180.0 / std::numbers::pi);
   }
-  const double cosine = std::abs(dotProduct) / std::sqrt(normalLength * referenceLength);
-  return std::acos(std::min(1.0, cosine)) * 180.0 / std::numbers::pi;
+  return best;
 }
 
 // ---------------------------------------------------------------------------------------
