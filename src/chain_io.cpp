@@ -1,3 +1,4 @@
+#include "examples.hpp"
 #include "input_file.hpp"
 #include "scallop/chain_io.hpp"
 
@@ -333,12 +334,7 @@ Chain sineChain() {
   return chain;
 }
 
-struct Example {
-  const char* name;
-  Chain (*make)();
-};
-
-constexpr Example kExamples[] = {
+constexpr detail::Example<Chain> kExamples[] = {
     {"figure2", figure2Chain},
     {"steps", stepsChain},
     {"sawtooth", sawtoothChain},
@@ -363,21 +359,11 @@ Chain parseChain(std::string_view content, const std::string& sourceName) {
 Chain readChain(const std::string& path) { return parseChain(detail::readInputFile(path), path); }
 
 std::vector<std::string> exampleChainNames() {
-  std::vector<std::string> names;
-  for (const Example& example : kExamples) names.emplace_back(example.name);
-  return names;
+  return detail::exampleNames<Chain>(kExamples);
 }
 
 Chain exampleChain(const std::string& name) {
-  for (const Example& example : kExamples) {
-    if (name == example.name) return example.make();
-  }
-  std::string known;
-  for (const Example& example : kExamples) {
-    known += known.empty() ? "" : ", ";
-    known += example.name;
-  }
-  throw Error(fmt::format("unknown example chain '{}' (known: {})", name, known));
+  return detail::makeExample<Chain>(kExamples, name, "chain");
 }
 
 }  // namespace scallop

@@ -1,3 +1,4 @@
+#include "examples.hpp"
 #include "input_file.hpp"
 #include "scallop/surface.hpp"
 
@@ -533,12 +534,7 @@ Surface paper2() {
   return {Units::inch, {gridBicubic(z)}};
 }
 
-struct Example {
-  const char* name;
-  Surface (*make)();
-};
-
-constexpr Example kExamples[] = {
+constexpr detail::Example<Surface> kExamples[] = {
     {"paper-1", paper1},
     {"paper-2", paper2},
 };
@@ -626,21 +622,11 @@ double surfaceScale(const Surface& surface) {
 }
 
 std::vector<std::string> exampleSurfaceNames() {
-  std::vector<std::string> names;
-  for (const Example& example : kExamples) names.emplace_back(example.name);
-  return names;
+  return detail::exampleNames<Surface>(kExamples);
 }
 
 Surface exampleSurface(const std::string& name) {
-  for (const Example& example : kExamples) {
-    if (name == example.name) return example.make();
-  }
-  std::string known;
-  for (const Example& example : kExamples) {
-    known += known.empty() ? "" : ", ";
-    known += example.name;
-  }
-  throw Error(fmt::format("unknown example surface '{}' (known: {})", name, known));
+  return detail::makeExample<Surface>(kExamples, name, "surface");
 }
 
 }  // namespace scallop

@@ -66,6 +66,24 @@ class CliFixture : public ::testing::Test {
     return result;
   }
 
+  // A run on bad input failed cleanly: exit status 1, one line "scallop: error: ..." on
+  // stderr containing every one of `messageParts`, nothing on stdout, and no file left in the
+  // work directory but the input the test wrote (`inputName`, or none).
+  void expectCleanFailure(const RunResult& result, const std::vector<std::string>& messageParts,
+                          const char* inputName) const {
+    EXPECT_EQ(result.exitCode, 1);
+    EXPECT_EQ(result.err.rfind("scallop: error: ", 0), 0u) << result.err;
+    for (const std::string& part : messageParts) {
+      EXPECT_NE(result.err.find(part), std::string::npos)
+          << "stderr '" << result.err << "' lacks '" << part << "'";
+    }
+    EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+    EXPECT_TRUE(result.out.empty()) << result.out;
+    const std::vector<std::string> expected =
+        inputName == nullptr ? std::vector<std::string>{} : std::vector<std::string>{inputName};
+    EXPECT_EQ(listing(), expected);
+  }
+
   // The names in the work directory, sorted (not recursive).
   std::vector<std::string> listing() const {
     std::vector<std::string> names;

@@ -104,18 +104,7 @@ TEST_F(OrientCli, BadInputFailsWithMessageAndWritesNothing) {
     if (bad.inputName != nullptr) write(bad.inputName, bad.content);
     const RunResult result =
         run(std::string("orient ") + bad.arguments + " --json out.json --svg-dir figs");
-    EXPECT_EQ(result.exitCode, 1);
-    EXPECT_EQ(result.err.rfind("scallop: error: ", 0), 0u) << result.err;
-    for (const std::string& part : bad.messageParts) {
-      EXPECT_NE(result.err.find(part), std::string::npos)
-          << "stderr '" << result.err << "' lacks '" << part << "'";
-    }
-    EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
-    EXPECT_TRUE(result.out.empty()) << result.out;
-    const std::vector<std::string> expected = bad.inputName == nullptr
-                                                  ? std::vector<std::string>{}
-                                                  : std::vector<std::string>{bad.inputName};
-    EXPECT_EQ(listing(), expected);
+    expectCleanFailure(result, bad.messageParts, bad.inputName);
   }
 }
 
