@@ -11,7 +11,7 @@
 
 namespace scallop::cli {
 
-double parsePositive(const std::string& text, const char* what, const char* expected) {
+double parseFinite(const std::string& text, const char* what, const char* expected) {
   std::string_view digits = text;
   if (digits.size() > 1 && digits.front() == '+' && digits[1] != '-' && digits[1] != '+') {
     digits.remove_prefix(1);
@@ -28,11 +28,16 @@ double parsePositive(const std::string& text, const char* what, const char* expe
   if (std::isnan(value)) {
     throw Error(fmt::format("invalid {} '{}': not a number; expected {}", what, text, expected));
   }
-  if (!(value > 0.0)) {
-    throw Error(fmt::format("invalid {} '{}': must be positive", what, text));
-  }
   if (std::isinf(value)) {
     throw Error(fmt::format("invalid {} '{}': expected {}", what, text, expected));
+  }
+  return value;
+}
+
+double parsePositive(const std::string& text, const char* what, const char* expected) {
+  const double value = parseFinite(text, what, expected);
+  if (!(value > 0.0)) {
+    throw Error(fmt::format("invalid {} '{}': must be positive", what, text));
   }
   return value;
 }

@@ -11,4 +11,7 @@ namespace scallop::cli {
 /// "invalid <what> '<text>': ..." (`expected` describes what would have been accepted).
 double parsePositive(const std::string& text, const char* what, const char* expected);
 
+/// Any finite number, with the same rules and errors as parsePositive.
+double parseFinite(const std::string& text, const char* what, const char* expected);
+
 }  // namespace scallop::cli

@@ -15,4 +15,10 @@ void addHullCommand(CLI::App& app);
 /// `scallop orient`: the optimal slicing orientation of a surface, as JSON and/or SVG figures.
 void addOrientCommand(CLI::App& app);
 
+/// `scallop paths`: contour or raster tool paths of a surface, as JSON, G-code and/or SVG.
+void addPathsCommand(CLI::App& app);
+
+/// `scallop plan`: the main job, surface to G-code, report and figures in one folder.
+void addPlanCommand(CLI::App& app);
+
 }  // namespace scallop::cli

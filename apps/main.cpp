@@ -29,12 +29,14 @@ int main(int argc, char** argv) {
   CLI::App app{
       "Exact tool paths for ball-end milling: the scallop hull of a monotone chain "
       "(a section of a surface) and its offset, the tool-centre path; and the optimal slicing "
-      "orientation of a free-form surface.",
+      "orientation of a free-form surface; contour and raster tool paths and G-code from them.",
       "scallop"};
   app.set_version_flag("--version", std::string("scallop ") + SCALLOP_VERSION);
   app.require_subcommand(1);
   scallop::cli::addHullCommand(app);
   scallop::cli::addOrientCommand(app);
+  scallop::cli::addPathsCommand(app);
+  scallop::cli::addPlanCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {

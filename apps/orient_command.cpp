@@ -18,6 +18,7 @@
 
 #include "arguments.hpp"
 #include "commands.hpp"
+#include "output_directory.hpp"
 #include "scallop/error.hpp"
 #include "scallop/file_output.hpp"
 #include "scallop/optimal_slicing.hpp"
@@ -84,37 +85,6 @@ std::string jsonDestination(const OrientOptions& options) {
 std::string sourceName(const OrientOptions& options) {
   if (!options.example.empty()) return "example " + options.example;
   return options.input == kStandardStream ? std::string("<stdin>") : options.input;
-}
-
-// Creates `directory` and any missing parents; returns those it created, deepest first, so
-// that a failed run can remove them again.
-std::vector<fs::path> createDirectories(const fs::path& directory) {
-  std::vector<fs::path> missing;
-  for (fs::path p = directory; !p.empty() && !fs::exists(p); p = p.parent_path()) {
-    missing.push_back(p);
-    if (p == p.parent_path()) break;
-  }
-  std::error_code error;
-  fs::create_directories(directory, error);
-  if (error) {
-    throw Error(fmt::format("cannot create directory '{}': {}", directory.string(),
-                            error.message()));
-  }
-  return missing;
-}
-
-// Writes the outputs all or nothing, creating the figures' directory first; on failure
-// removes the directories this run created (they are empty again by then).
-void writeOutputs(const std::vector<OutputFile>& outputs, const std::string& svgDir) {
-  const std::vector<fs::path> created = svgDir.empty() ? std::vector<fs::path>{}
-                                                       : createDirectories(svgDir);
-  try {
-    writeFilesAtomically(outputs);
-  } catch (...) {
-    std::error_code ignored;
-    for (const fs::path& directory : created) fs::remove(directory, ignored);
-    throw;
-  }
 }
 
 std::string certificateSummary(const OptimalSlicing& result, bool certify) {

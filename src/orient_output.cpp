@@ -15,6 +15,7 @@
 
 #include "scallop/error.hpp"
 #include "scallop/stereographic.hpp"
+#include "json_format.hpp"
 #include "svg_format.hpp"
 
 namespace scallop {
@@ -86,37 +87,6 @@ Json documentJson(const OptimalSlicing& result, double toleranceDeg) {
   document["medial_axis"] = medialAxis;
   document["seconds"] = result.seconds;
   return document;
-}
-
-// Objects expanded, one key per line and indented by two per level; arrays (vectors) kept
-// on one line. Numbers are nlohmann's shortest round-trip form.
-void dumpValue(const Json& value, std::size_t indent, std::string& out) {
-  if (value.is_array()) {
-    out += '[';
-    for (std::size_t i = 0; i < value.size(); ++i) {
-      if (i > 0) out += ", ";
-      out += value[i].dump();
-    }
-    out += ']';
-    return;
-  }
-  if (!value.is_object() || value.empty()) {
-    out += value.dump();
-    return;
-  }
-  out += "{\n";
-  bool first = true;
-  for (const auto& [key, item] : value.items()) {
-    out += first ? "" : ",\n";
-    first = false;
-    out.append(indent + 2, ' ');
-    out += Json(key).dump();
-    out += ": ";
-    dumpValue(item, indent + 2, out);
-  }
-  out += '\n';
-  out.append(indent, ' ');
-  out += '}';
 }
 
 // =======================================================================================
@@ -953,9 +923,7 @@ std::string planeScaleBar(const PlaneView& view) {
 // =======================================================================================
 
 std::string orientationToJson(const OptimalSlicing& result, double toleranceDeg) {
-  std::string out;
-  dumpValue(documentJson(result, toleranceDeg), 0, out);
-  return out + "\n";
+  return json::format(documentJson(result, toleranceDeg));
 }
 
 std::string gaussMapSphereSvg(const OptimalSlicing& result) {

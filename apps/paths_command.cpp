@@ -1,0 +1,144 @@
+// `scallop paths`: tool paths for a surface with a ball-end cutter, by the contour strategy
+// (planes N . r = k Delta, N the optimal N* or given) or the raster strategy (vertical planes,
+// each section's tool path from the scallop hull's offset), as JSON, G-code and/or a figure.
+// Every output is computed first and the files are written all or nothing.
+
+#include <cstdio>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <CLI/CLI.hpp>
+
+#include "arguments.hpp"
+#include "commands.hpp"
+#include "output_directory.hpp"
+#include "scallop/error.hpp"
+#include "scallop/gcode.hpp"
+#include "scallop/paths_output.hpp"
+#include "scallop/surface.hpp"
+#include "toolpath_job.hpp"
+
+namespace scallop::cli {
+namespace {
+
+constexpr const char* kStandardStream = "-";
+
+struct PathsOptions {
+  std::string input;
+  std::string example;
+  std::string toolRadius;
+  std::string spacing;
+  std::string scallopHeight;
+  std::string strategy = "contour";
+  std::string normal = "auto";
+  std::string angle;
+  std::string dialect = "linuxcnc";
+  std::string jsonPath;
+  std::string gcodePath;
+  std::string svgPath;
+  bool noGougeCheck = false;
+};
+
+void runPaths(const PathsOptions& options) {
+  if (options.input.empty() == options.example.empty())
+    throw CLI::ValidationError("paths", "give the surface either as SURFACE.json or as --example NAME");
+  if (options.spacing.empty() == options.scallopHeight.empty())
+    throw CLI::ValidationError("paths", "give exactly one of --spacing and --scallop-height");
+  if (options.strategy == "contour" && !options.angle.empty())
+    throw CLI::ValidationError("paths", "--angle is for --strategy raster");
+  if (options.strategy == "raster" && options.normal != "auto")
+    throw CLI::ValidationError("paths", "--normal is for --strategy contour");
+  JobOptions job;
+  job.strategy = options.strategy;
+  job.toolRadius = parsePositive(options.toolRadius, "tool radius", "a positive length");
+  if (!options.spacing.empty())
+    job.spacing = parsePositive(options.spacing, "spacing", "a positive length");
+  if (!options.scallopHeight.empty())
+    job.scallopHeight = parsePositive(options.scallopHeight, "scallop height", "a positive length");
+  if (options.normal != "auto") job.normal = parseNormal(options.normal);
+  if (!options.angle.empty()) job.angleDeg = parseFinite(options.angle, "angle", "degrees");
+  job.gougeCheck = !options.noGougeCheck;
+
+  const Surface surface =
+      options.example.empty() ? readSurface(options.input) : exampleSurface(options.example);
+  const std::string source = options.example.empty() ? options.input : "example " + options.example;
+  const JobResult result = runToolpathJob(surface, source, job, std::nullopt, {});
+
+  std::vector<OutputFile> outputs;
+  const bool anyOutput = !options.jsonPath.empty() || !options.gcodePath.empty() || !options.svgPath.empty();
+  const std::string jsonPath = anyOutput ? options.jsonPath : std::string(kStandardStream);
+  if (!jsonPath.empty()) outputs.push_back({jsonPath, pathsToJson(result.report, result.path)});
+  if (!options.gcodePath.empty()) {
+    const GcodeDialect dialect = options.dialect == "grbl" ? GcodeDialect::grbl : GcodeDialect::linuxcnc;
+    const std::string title = fmt::format("scallop paths {} {}", options.strategy, source);
+    outputs.push_back({options.gcodePath,
+                       gcodeProgram(result.path, defaultGcodeOptions(surface, result.path, dialect, title))});
+  }
+  if (!options.svgPath.empty()) {
+    outputs.push_back({options.svgPath,
+                       pathsSvg(surface, result.contactCurves, result.path,
+                                fmt::format("scallop paths: {} strategy, {}", options.strategy, source),
+                                /*planView=*/false)});
+  }
+  writeOutputs(outputs, "");
+  if (jsonPath != kStandardStream) {
+    const PathStats& s = result.report.stats;
+    fmt::print(stderr,
+               "scallop: {}: {} paths, spacing {:.6g}, {} planes, {} components, tool-centre "
+               "length {:.6g} {}, {:.3f} s\n",
+               source, options.strategy, result.report.spacing, s.planes, s.components,
+               s.centreLength, unitsName(surface.units), result.report.seconds);
+  }
+}
+
+}  // namespace
+
+void addPathsCommand(CLI::App& app) {
+  auto options = std::make_shared<PathsOptions>();
+  CLI::App* paths = app.add_subcommand(
+      "paths", "Tool paths for a ball-end cutter over a surface: contour or raster, as JSON, G-code, SVG");
+  paths->footer(
+      "Contour (default): planes N . r = k Delta, N the optimal slicing normal N* (--normal "
+      "auto) or given as X,Y,Z; the ball's centre follows r + R n along each section. Raster: "
+      "vertical planes along a feed direction (--angle DEG from +x, or the best one), each "
+      "section's tool path from its scallop hull (Chou et al. 1994), passes linked zigzag; the "
+      "ball is then checked against the whole surface and the deepest interference reported. "
+      "Delta is --spacing, or derived from --scallop-height H and the least angle alpha between "
+      "the planes and the surface: Delta = 2 sqrt(2 R H - H^2) sin(alpha).\n"
+      "Example: scallop paths --example paper-1 --tool-radius 0.25 --scallop-height 0.001 "
+      "--gcode out.ngc --svg out.svg");
+  CLI::Option* file = paths->add_option("SURFACE", options->input, "surface file (JSON); - reads standard input")
+                          ->type_name("");
+  CLI::Option* example = paths->add_option("--example", options->example, "use a built-in example surface")
+                             ->check(CLI::IsMember(exampleSurfaceNames()))
+                             ->type_name("NAME");
+  file->excludes(example);
+  paths->add_option("--tool-radius", options->toolRadius, "ball radius R, in the surface's units")
+      ->required()
+      ->type_name("R");
+  paths->add_option("--spacing", options->spacing, "distance Delta between the planes")->type_name("D");
+  paths->add_option("--scallop-height", options->scallopHeight, "largest scallop height H (< R)")
+      ->type_name("H");
+  paths->add_option("--strategy", options->strategy, "contour (default) or raster")
+      ->check(CLI::IsMember({"contour", "raster"}))
+      ->type_name("NAME");
+  paths->add_option("--normal", options->normal, "contour: auto (the optimal N*, default) or X,Y,Z")
+      ->type_name("auto|X,Y,Z");
+  paths->add_option("--angle", options->angle, "raster: feed direction in degrees from +x (default: the best)")
+      ->type_name("DEG");
+  paths->add_option("--dialect", options->dialect, "G-code dialect: linuxcnc (default) or grbl")
+      ->check(CLI::IsMember({"linuxcnc", "grbl"}))
+      ->type_name("NAME");
+  paths->add_option("--json", options->jsonPath, "write the report and the passes as JSON (- = standard output)")
+      ->type_name("OUT");
+  paths->add_option("--gcode", options->gcodePath, "write the G-code program")->type_name("OUT");
+  paths->add_option("--svg", options->svgPath, "write a picture of the surface, the sections and the paths")
+      ->type_name("OUT");
+  paths->add_flag("--no-gouge-check", options->noGougeCheck, "raster: skip the ball-against-surface check");
+  paths->callback([options] { runPaths(*options); });
+}
+
+}  // namespace scallop::cli

@@ -1,0 +1,151 @@
+// `scallop plan`: the main job. A surface (the paper's test surface 1 unless given), a ball
+// radius and a scallop height become a tool path by the contour strategy on the optimal
+// planes (or the raster strategy), written with its report and figures into one folder:
+//   toolpath.ngc        G-code (LinuxCNC; --dialect grbl for grbl)
+//   report.json         parameters, statistics, the optimal orientation, the passes
+//   paths.svg           the surface, its sections and the tool-centre paths (axonometric)
+//   paths-plan.svg      the same seen from above
+//   gauss-map.svg       the symmetrized Gauss map and the optimal circle on the sphere
+//   stereographic.svg   the stereographic plane with the medial axis and the optimal circle
+// Everything is computed first; the folder is written all or nothing.
+
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <CLI/CLI.hpp>
+
+#include "arguments.hpp"
+#include "commands.hpp"
+#include "output_directory.hpp"
+#include "scallop/error.hpp"
+#include "scallop/gcode.hpp"
+#include "scallop/optimal_slicing.hpp"
+#include "scallop/orient_output.hpp"
+#include "scallop/paths_output.hpp"
+#include "scallop/surface.hpp"
+#include "toolpath_job.hpp"
+
+namespace scallop::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct PlanOptions {
+  std::string input;
+  std::string example;
+  std::string strategy = "contour";
+  std::string toolRadius;
+  std::string scallopHeight;
+  std::string spacing;
+  std::string dialect = "linuxcnc";
+  std::string out = "scallop-out";
+  bool quiet = false;
+};
+
+void runPlan(const PlanOptions& options) {
+  if (!options.input.empty() && !options.example.empty())
+    throw CLI::ValidationError("plan", "give the surface either as SURFACE.json or as --example NAME");
+  if (!options.spacing.empty() && !options.scallopHeight.empty())
+    throw CLI::ValidationError("plan", "give at most one of --spacing and --scallop-height");
+  const std::string exampleName =
+      options.input.empty() ? (options.example.empty() ? "paper-1" : options.example) : "";
+  const Surface surface = exampleName.empty() ? readSurface(options.input) : exampleSurface(exampleName);
+  const std::string source = exampleName.empty() ? options.input : "example " + exampleName;
+  const bool inch = surface.units == Units::inch;
+  auto progress = [&](const std::string& line) {
+    if (!options.quiet) fmt::print(stderr, "scallop plan: {}...\n", line);
+  };
+
+  JobOptions job;
+  job.strategy = options.strategy;
+  // Defaults: a 1/2 inch (12 mm) ball-end mill and a finishing scallop of 0.001 in (0.025 mm).
+  job.toolRadius = options.toolRadius.empty()
+                       ? (inch ? 0.25 : 6.0)
+                       : parsePositive(options.toolRadius, "tool radius", "a positive length");
+  if (!options.spacing.empty()) {
+    job.spacing = parsePositive(options.spacing, "spacing", "a positive length");
+  } else {
+    job.scallopHeight = options.scallopHeight.empty()
+                            ? (inch ? 0.001 : 0.025)
+                            : parsePositive(options.scallopHeight, "scallop height", "a positive length");
+  }
+  progress("computing the optimal slicing orientation N* (Gauss map, medial axis, certificate)");
+  OptimalSlicing orientation = optimalSlicing(surface);
+  JobResult result = runToolpathJob(surface, source, job, orientation, progress);
+  PathsReport& report = result.report;
+  report.orientation = OrientationSummary{orientation.normal, orientation.alphaRad,
+                                          orientation.certified,
+                                          orientation.gaussMap.boundarySegments, orientation.seconds};
+
+  progress("writing G-code, report and figures");
+  const GcodeDialect dialect = options.dialect == "grbl" ? GcodeDialect::grbl : GcodeDialect::linuxcnc;
+  const std::string title = fmt::format("scallop plan {} {}", options.strategy, source);
+  const fs::path dir = options.out;
+  const std::string figureTitle = fmt::format(
+      "scallop plan: {} strategy on {}, R = {} {}, spacing {:.5g}, {} passes", options.strategy,
+      source, job.toolRadius, unitsName(surface.units), report.spacing, result.path.passes.size());
+  std::vector<OutputFile> outputs{
+      {(dir / (dialect == GcodeDialect::grbl ? "toolpath.gcode" : "toolpath.ngc")).string(),
+       gcodeProgram(result.path, defaultGcodeOptions(surface, result.path, dialect, title))},
+      {(dir / "report.json").string(), pathsToJson(report, result.path)},
+      {(dir / "paths.svg").string(), pathsSvg(surface, result.contactCurves, result.path, figureTitle, false)},
+      {(dir / "paths-plan.svg").string(), pathsSvg(surface, result.contactCurves, result.path, figureTitle, true)},
+      {(dir / "gauss-map.svg").string(), gaussMapSphereSvg(orientation)},
+      {(dir / "stereographic.svg").string(), stereographicSvg(orientation)},
+  };
+  writeOutputs(outputs, options.out);
+  const PathStats& s = report.stats;
+  std::string gouge;
+  if (report.gouge)
+    gouge = fmt::format(", deepest ball interference {:.6f} {} (bound {:.6f})", report.gouge->maxDepth,
+                        unitsName(surface.units), report.gouge->depthBound);
+  fmt::print(stderr,
+             "scallop plan: {} on {}: N* = ({:.4f}, {:.4f}, {:.4f}), alpha* = {:.3f} deg; spacing "
+             "{:.5g}, {} planes, {} components, tool-centre length {:.4f} {}{}; {:.2f} s -> {}/\n",
+             options.strategy, source, orientation.normal.x, orientation.normal.y,
+             orientation.normal.z, orientation.alphaRad * 180.0 / 3.141592653589793, report.spacing,
+             s.planes, s.components, s.centreLength, unitsName(surface.units), gouge,
+             report.seconds + orientation.seconds, options.out);
+}
+
+}  // namespace
+
+void addPlanCommand(CLI::App& app) {
+  auto options = std::make_shared<PlanOptions>();
+  CLI::App* plan = app.add_subcommand(
+      "plan", "The main job: surface -> optimal orientation -> tool paths -> G-code, report, figures");
+  plan->footer(
+      "With no arguments: the paper's test surface 1 (inches), a 0.25 in ball, a 0.001 in "
+      "scallop height, the contour strategy on the optimal planes N*; writes toolpath.ngc, "
+      "report.json, paths.svg, paths-plan.svg, gauss-map.svg and stereographic.svg into "
+      "scallop-out/ (or --out DIR), all or nothing.");
+  CLI::Option* file = plan->add_option("SURFACE", options->input, "surface file (JSON); - reads standard input")
+                          ->type_name("");
+  CLI::Option* example = plan->add_option("--example", options->example, "a built-in example (default paper-1)")
+                             ->check(CLI::IsMember(exampleSurfaceNames()))
+                             ->type_name("NAME");
+  file->excludes(example);
+  plan->add_option("--strategy", options->strategy, "contour (default) or raster")
+      ->check(CLI::IsMember({"contour", "raster"}))
+      ->type_name("NAME");
+  plan->add_option("--tool-radius", options->toolRadius, "ball radius R (default 0.25 in or 6 mm)")
+      ->type_name("R");
+  plan->add_option("--scallop-height", options->scallopHeight,
+                   "largest scallop height H (default 0.001 in or 0.025 mm)")
+      ->type_name("H");
+  plan->add_option("--spacing", options->spacing, "plane spacing Delta instead of a scallop height")
+      ->type_name("D");
+  plan->add_option("--dialect", options->dialect, "G-code dialect: linuxcnc (default) or grbl")
+      ->check(CLI::IsMember({"linuxcnc", "grbl"}))
+      ->type_name("NAME");
+  plan->add_option("--out", options->out, "output folder (default scallop-out)")->type_name("DIR");
+  plan->add_flag("--quiet", options->quiet, "no progress lines");
+  plan->callback([options] { runPlan(*options); });
+}
+
+}  // namespace scallop::cli

@@ -1,0 +1,190 @@
+#include "toolpath_job.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "arguments.hpp"
+#include "scallop/contour.hpp"
+#include "scallop/error.hpp"
+#include "scallop/gouge.hpp"
+#include "scallop/raster.hpp"
+
+namespace scallop::cli {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+void say(const Progress& progress, const std::string& line) {
+  if (progress) progress(line);
+}
+
+std::vector<Vec3> curvePoints(const SectionCurve& curve) {
+  std::vector<Vec3> points;
+  points.reserve(curve.points.size());
+  for (const SectionPoint& p : curve.points) points.push_back(p.point);
+  return points;
+}
+
+void runContour(const Surface& surface, const JobOptions& options, JobResult& result,
+                const Progress& progress) {
+  Vec3 normal;
+  double alpha = 0.0;
+  if (options.normal) {
+    normal = normalized(*options.normal);
+    say(progress, "bounding the angle between the planes and the surface normals");
+    alpha = minimumAngleBound(surface, normal);
+  } else {
+    if (!result.orientation) {
+      say(progress, "computing the optimal slicing orientation N*");
+      result.orientation = optimalSlicing(surface);
+    }
+    normal = result.orientation->normal;
+    // Machining from above: the planes' normal sign is free; prefer N . z >= 0.
+    if (normal.z < 0.0) normal = -normal;
+    alpha = result.orientation->certified ? result.orientation->certifiedAlphaRad
+                                          : minimumAngleBound(surface, normal);
+  }
+  ContourOptions contour;
+  contour.normal = normal;
+  contour.toolRadius = options.toolRadius;
+  contour.spacing = options.spacing ? *options.spacing
+                                    : spacingForScallopHeight(options.toolRadius,
+                                                              *options.scallopHeight, alpha);
+  say(progress, fmt::format("cutting the surface with planes {:.6g} apart", contour.spacing));
+  ContourPaths paths = contourPaths(surface, contour);
+  result.report.spacing = paths.spacing;
+  result.report.planeNormal = paths.normal;
+  result.report.alphaRad = alpha;
+  result.report.stats = paths.stats;
+  for (const ContourSection& section : paths.sections)
+    for (const SectionCurve& curve : section.section.curves)
+      result.contactCurves.push_back(curvePoints(curve));
+  result.path = std::move(paths.path);
+}
+
+void runRaster(const Surface& surface, const JobOptions& options, JobResult& result,
+               const Progress& progress) {
+  RasterOptions raster;
+  raster.toolRadius = options.toolRadius;
+  if (options.angleDeg) {
+    raster.angleRad = *options.angleDeg * kDeg;
+  } else {
+    raster.bestAngle = true;
+    say(progress, "searching the feed direction with the widest step-over");
+  }
+  if (options.spacing) raster.spacing = *options.spacing;
+  if (options.scallopHeight) raster.scallopHeight = *options.scallopHeight;
+  say(progress, "cutting the surface with vertical planes; scallop hull of each section");
+  RasterPaths paths = rasterPaths(surface, raster);
+  result.report.spacing = paths.spacing;
+  result.report.planeNormal = paths.planeNormal;
+  result.report.alphaRad = paths.alphaRad;
+  result.report.feedAngleRad = paths.angleRad;
+  result.report.stats = paths.stats;
+  for (const RasterSection& section : paths.sections)
+    for (const SectionCurve& curve : section.section.curves)
+      result.contactCurves.push_back(curvePoints(curve));
+  result.path = std::move(paths.path);
+  if (options.gougeCheck) {
+    // Samples every R / 10 along the path: the bound between samples adds R / 20.
+    const double spacing = options.toolRadius / 10.0;
+    say(progress, fmt::format("checking the ball against the whole surface every {:.6g}", spacing));
+    const GougeReport gouge = gougeCheck(surface, result.path, spacing);
+    GougeSummary summary;
+    summary.maxDepth = gouge.maxDepth;
+    summary.signedMaxDepth = gouge.signedMaxDepth;
+    summary.depthBound = gouge.depthBound;
+    summary.sampleSpacing = spacing;
+    summary.samples = gouge.samples;
+    summary.where = gouge.deepest.center;
+    summary.pass = gouge.deepest.pass;
+    result.report.gouge = summary;
+  }
+}
+
+}  // namespace
+
+JobResult runToolpathJob(const Surface& surface, const std::string& source,
+                         const JobOptions& options, std::optional<OptimalSlicing> orientation,
+                         const Progress& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  if (!(options.toolRadius > 0.0) || !std::isfinite(options.toolRadius))
+    throw Error(fmt::format("the tool radius must be positive, got {}", options.toolRadius));
+  if (options.spacing.has_value() == options.scallopHeight.has_value())
+    throw Error("give exactly one of --spacing and --scallop-height");
+  if (options.scallopHeight && !(*options.scallopHeight < options.toolRadius))
+    throw Error(fmt::format("the scallop height {} must be smaller than the tool radius {}",
+                            *options.scallopHeight, options.toolRadius));
+  JobResult result;
+  result.orientation = std::move(orientation);
+  result.report.strategy = options.strategy;
+  result.report.source = source;
+  result.report.units = surface.units;
+  result.report.toolRadius = options.toolRadius;
+  result.report.scallopHeight = options.scallopHeight;
+  if (options.strategy != "contour" && options.strategy != "raster")
+    throw Error(fmt::format("unknown strategy '{}': expected contour or raster", options.strategy));
+  // What goes wrong from here on is about the surface (or the planes against it): say which.
+  try {
+    if (options.strategy == "contour") {
+      runContour(surface, options, result, progress);
+    } else {
+      runRaster(surface, options, result, progress);
+    }
+  } catch (const Error& error) {
+    throw Error(fmt::format("{}: {}", source, error.what()));
+  }
+  result.report.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+GcodeOptions defaultGcodeOptions(const Surface& surface, const ToolPath& path,
+                                 GcodeDialect dialect, const std::string& title) {
+  const bool inch = surface.units == Units::inch;
+  GcodeOptions options;
+  options.dialect = dialect;
+  options.feedRate = inch ? 40.0 : 1000.0;
+  options.plungeFeedRate = inch ? 15.0 : 400.0;
+  options.spindleRpm = 10000.0;
+  options.title = title;
+  // Tips are centres - R; arcs bulge at most R above their ends' centre height... their
+  // centres are chain vertices, below the path, so the ends and line vertices bound them.
+  double top = -std::numeric_limits<double>::infinity();
+  for (const BezierPatch& patch : surface.patches)
+    for (const Vec3& p : patch.control) top = std::max(top, p.z);
+  for (const ToolPass& pass : path.passes) {
+    top = std::max(top, pass.start.z - path.toolRadius);
+    for (const ToolMove& move : pass.moves) {
+      top = std::max(top, move.end.z - path.toolRadius);
+      if (move.kind == MoveKind::arc)
+        top = std::max(top, move.center.z + norm(move.end - move.center) - path.toolRadius);
+    }
+  }
+  options.safeHeight = top + (inch ? 0.2 : 5.0);
+  return options;
+}
+
+Vec3 parseNormal(const std::string& text) {
+  std::vector<std::string> parts;
+  std::stringstream stream(text);
+  for (std::string part; std::getline(stream, part, ',');) parts.push_back(part);
+  if (parts.size() != 3 || text.back() == ',')
+    throw Error(fmt::format("invalid normal '{}': expected X,Y,Z (three numbers) or auto", text));
+  const Vec3 n{parseFinite(parts[0], "normal x", "a number"),
+               parseFinite(parts[1], "normal y", "a number"),
+               parseFinite(parts[2], "normal z", "a number")};
+  if (n.x == 0.0 && n.y == 0.0 && n.z == 0.0)
+    throw Error(fmt::format("invalid normal '{}': the zero vector has no direction", text));
+  if (!std::isfinite(norm(n)))
+    throw Error(fmt::format("invalid normal '{}': too large", text));
+  return n;
+}
+
+}  // namespace scallop::cli

@@ -1,0 +1,86 @@
+#pragma once
+// Contour machining on parallel planes (Smith, Farouki, al-Kandari, Pottmann, "Optimal
+// slicing of free-form surfaces", Section 4 and Table 1): the surface is cut by the planes
+// N . r = k Delta (eq. (3), k an integer), each section is a contact locus of the ball-end
+// cutter, and the ball's centre follows its offset r + R n.
+//
+// Contract
+// --------
+// Input:  a valid surface (surface.hpp) to be cut from above (z up): each patch is oriented
+//         so that its normal at the parameter centre points up (n_z >= 0); a plane normal N
+//         (finite, non-zero; normalised); a spacing Delta > 0 between planes; a ball radius
+//         R > 0; a chordal tolerance (surface units) for the traced sections.
+// Output: every plane N . r = k Delta that cuts the surface (k from the control points'
+//         extent, so no plane is missed), its section (section.hpp), and one tool pass per
+//         section curve through the centres r + R n at the curve's vertices (n the unit
+//         normal at the vertex's (u, v), oriented as above); passes follow the planes in
+//         increasing k, each entered from the safe height. Statistics: planes that cut,
+//         connected components (summed over planes), the contact-locus length and the
+//         tool-centre path length (polyline lengths).
+// Scallop height: planes Delta apart meet the surface in curves whose local distance on the
+//         surface is l = Delta / sqrt(1 - (N . n)^2) = Delta / sin(angle(N, n)); the ball
+//         leaves a cusp of height h = R - sqrt(R^2 - l^2 / 4) between neighbouring passes
+//         (on a locally flat surface). The worst case is at the smallest angle alpha between
+//         N and +-n over the surface, so h <= H everywhere when
+//         Delta = 2 sqrt(2 R H - H^2) sin(alpha)   (spacingForScallopHeight).
+//         This is why the optimal N* (largest alpha*) allows the widest planes for a given
+//         scallop height: the path is shortest.
+// Complexity: one planeSection per plane: O(planes * (cells + vertices)).
+
+#include <cstddef>
+#include <vector>
+
+#include "scallop/section.hpp"
+#include "scallop/surface.hpp"
+#include "scallop/toolpath.hpp"
+#include "scallop/vector.hpp"
+
+namespace scallop {
+
+struct ContourOptions {
+  Vec3 normal{0.0, 0.0, 1.0};   ///< N, any length (normalised)
+  double spacing = 0.0;         ///< Delta > 0, surface units
+  double toolRadius = 0.0;      ///< R > 0, surface units
+  double chordalTolerance = 0.0;  ///< > 0; 0 means 1e-4 times the surface's largest coordinate
+};
+
+struct PathStats {
+  std::size_t planes = 0;        ///< planes that cut the surface
+  std::size_t components = 0;    ///< connected pieces of the sections, summed over planes
+  double contactLength = 0.0;    ///< total length of the contact loci (sections)
+  double centreLength = 0.0;     ///< total length of the tool-centre paths
+  std::size_t touchPoints = 0;   ///< isolated tangent points (no path)
+};
+
+struct ContourSection {
+  double offset = 0.0;  ///< k Delta: the plane N . r = offset (N unit)
+  long long k = 0;
+  PlaneSection section;
+};
+
+struct ContourPaths {
+  Vec3 normal;     ///< N, unit
+  double spacing = 0.0;
+  std::vector<ContourSection> sections;  ///< the planes that cut, in increasing k
+  ToolPath path;   ///< one pass per section curve, same order
+  PathStats stats;
+};
+
+/// The contour paths of `surface` (see the contract); throws scallop::Error on bad options.
+ContourPaths contourPaths(const Surface& surface, const ContourOptions& options);
+
+/// Delta = 2 sqrt(2 R H - H^2) sin(alpha): the plane spacing that keeps the scallop height
+/// below H where the planes meet the surface at angle >= alpha (radians) to its normal.
+/// Throws scallop::Error unless 0 < H < R and 0 < alpha <= pi / 2.
+double spacingForScallopHeight(double toolRadius, double scallopHeight, double alphaRad);
+
+/// The unit normal at (u, v) of patch `patch`, oriented up as the contract says.
+Vec3 upwardNormal(const Surface& surface, std::size_t patch, double u, double v);
+
+/// The smallest angle (radians) between `direction` and +-(surface normals), with a proof:
+/// the value is first estimated by sampling and local refinement, then lowered until the
+/// Bernstein-form certificate (optimal_slicing.hpp's certifyClearance) proves that no normal
+/// comes closer. The result is a proven lower bound within about 0.01 degree of the truth.
+double minimumAngleBound(const Surface& surface, const Vec3& direction);
+
+}  // namespace scallop

@@ -1,0 +1,73 @@
+#pragma once
+// What `scallop paths` and `scallop plan` write besides G-code: the JSON report of a tool
+// path (strategy, parameters, statistics, the gouge check, the passes themselves) and
+// pictures of it in the spirit of the paper's Figs 2, 6, 9 and 13 (the surface with its
+// sections and the tool-centre paths, in an axonometric view, and the plan view).
+//
+// Contract
+// --------
+// JSON: one object, keys in the documented order, every number shortest-round-trip (full
+//       double precision); positions are ball centres in the surface's units. Moves:
+//       {"line": [x, y, z]} or {"arc": {"end": [..], "center": [..], "plane": "xy"|"zx"|"yz",
+//       "clockwise": bool}} (clockwise as G2: seen from the plane normal's positive end).
+// SVG:  fixed-point coordinates only (never an exponent, nan or inf); deterministic.
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "scallop/contour.hpp"
+#include "scallop/surface.hpp"
+#include "scallop/toolpath.hpp"
+#include "scallop/vector.hpp"
+
+namespace scallop {
+
+/// The deepest interference of the ball with the surface along the path (gouge.hpp),
+/// summarised for the report.
+struct GougeSummary {
+  double maxDepth = 0.0;        ///< >= 0, surface units
+  double signedMaxDepth = 0.0;  ///< < 0: the closest approach left this much clearance
+  double depthBound = 0.0;      ///< proven bound between samples (maxDepth + spacing / 2)
+  double sampleSpacing = 0.0;
+  std::size_t samples = 0;
+  Vec3 where;                   ///< ball centre where the deepest interference happens
+  std::size_t pass = 0;
+};
+
+/// The optimal slicing orientation, when the job computed it (optimal_slicing.hpp).
+struct OrientationSummary {
+  Vec3 normal;
+  double alphaRad = 0.0;
+  bool certified = false;
+  std::size_t boundarySegments = 0;
+  double seconds = 0.0;
+};
+
+struct PathsReport {
+  std::string strategy;            ///< "contour" or "raster"
+  std::string source;              ///< the surface's file or example name
+  Units units = Units::inch;
+  double toolRadius = 0.0;
+  double spacing = 0.0;            ///< Delta between planes
+  std::optional<double> scallopHeight;  ///< H when Delta was derived from it
+  Vec3 planeNormal;                ///< N of the cutting planes (unit)
+  double alphaRad = 0.0;           ///< proven least angle between N and +-n
+  std::optional<double> feedAngleRad;   ///< raster: the feed direction's angle from +x
+  PathStats stats;
+  std::optional<GougeSummary> gouge;
+  std::optional<OrientationSummary> orientation;
+  double seconds = 0.0;
+};
+
+/// The report and the passes as JSON (see the contract).
+std::string pathsToJson(const PathsReport& report, const ToolPath& path);
+
+/// An axonometric picture of the surface (iso-parameter lines), the contact curves (the
+/// sections) and the tool-centre passes, with rapid moves dashed: as the paper's figures of
+/// the slicing planes on the test surfaces. `planView` looks straight down instead.
+std::string pathsSvg(const Surface& surface, const std::vector<std::vector<Vec3>>& contactCurves,
+                     const ToolPath& path, const std::string& title, bool planView);
+
+}  // namespace scallop

@@ -1,0 +1,58 @@
+#pragma once
+// The tool path in space: what the contour and raster strategies produce and what the
+// G-code writer, the JSON report and the figures consume.
+//
+// Contract
+// --------
+// Positions are the centre of the ball-end cutter, in the surface's units (inches or
+// millimetres), in the machine frame of a 3-axis mill: z up, the tool above the material.
+// (The G-code writer turns centres into the ball's tip, centre - R z, which is what a
+// controller with the tool length measured to the tip drives.)
+// A ToolPath is a sequence of passes in machining order. A pass is one uninterrupted cutting
+// move: it starts at `start` and each move runs from where the previous one ended to its
+// `end`. Between passes the tool either retracts (rapid up to the safe height, across, and
+// down: ToolPass::retractBefore == true) or feeds straight from the previous pass's end to
+// this pass's start (false: the strategy has checked that this link cannot gouge).
+// Arcs lie in a principal plane (the G-code planes G17 xy, G18 zx, G19 yz): `center` and
+// the two ends share the coordinate normal to the plane, and both ends lie at the same
+// distance from the centre (within rounding). `clockwise` is as seen from the positive end
+// of the axis normal to the plane, looking towards the origin: RS-274's G2. A quarter turn
+// or more is allowed, a full circle is not (start != end).
+
+#include <cstddef>
+#include <vector>
+
+#include "scallop/surface.hpp"
+#include "scallop/vector.hpp"
+
+namespace scallop {
+
+enum class ArcPlane {
+  xy,  ///< G17: normal +z
+  zx,  ///< G18: normal +y
+  yz,  ///< G19: normal +x
+};
+
+enum class MoveKind { line, arc };
+
+struct ToolMove {
+  MoveKind kind = MoveKind::line;
+  Vec3 end;                       ///< where the move ends (tool centre)
+  Vec3 center;                    ///< arc only
+  ArcPlane plane = ArcPlane::xy;  ///< arc only
+  bool clockwise = true;          ///< arc only: G2 when true, G3 when false
+};
+
+struct ToolPass {
+  Vec3 start;                   ///< tool centre where the pass begins
+  std::vector<ToolMove> moves;  ///< each from the previous end (or `start`) to its `end`
+  bool retractBefore = true;    ///< rapid via the safe height before this pass (see above)
+};
+
+struct ToolPath {
+  Units units = Units::inch;
+  double toolRadius = 0.0;        ///< R of the ball-end cutter, in `units`
+  std::vector<ToolPass> passes;   ///< in machining order
+};
+
+}  // namespace scallop

@@ -1,0 +1,880 @@
+// Distance from a point to a surface of Bezier patches by branch and bound, and the gouge
+// check of a tool path built on it. See include/scallop/gouge.hpp for the contract.
+
+#include "scallop/gouge.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "scallop/error.hpp"
+
+namespace scallop {
+
+namespace detail {
+
+struct Box {
+  Vec3 lo;
+  Vec3 hi;
+};
+
+// One patch's sub-patches to `levels - 1` halvings in u and v. Level L holds 4^L cells; the
+// cell (iu, iv), on [iu, iu + 1] x [iv, iv + 1] / 2^L, is at index iu 2^L + iv, its control
+// net at nets[L][index * stride], its axis-aligned box at boxes[L][index].
+struct PatchTree {
+  int degreeU = 0;
+  int degreeV = 0;
+  std::size_t stride = 0;  // (m + 1)(n + 1) control points per net
+  int levels = 0;
+  std::vector<std::vector<Vec3>> nets;
+  std::vector<std::vector<Box>> boxes;
+  double scale = 0.0;  // the largest |coordinate| of the patch's control points
+};
+
+}  // namespace detail
+
+namespace {
+
+using detail::Box;
+using detail::PatchTree;
+
+constexpr double kUnitRoundoff = std::numeric_limits<double>::epsilon() / 2;  // u = 2^-53
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+constexpr int kMaxTreeDepth = 6;
+
+bool isFinite(Vec3 a) { return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z); }
+double maxAbs(Vec3 a) { return std::max({std::abs(a.x), std::abs(a.y), std::abs(a.z)}); }
+
+Box boxOf(const Vec3* net, std::size_t count) {
+  Box box{net[0], net[0]};
+  for (std::size_t i = 1; i < count; ++i) {
+    box.lo = {std::min(box.lo.x, net[i].x), std::min(box.lo.y, net[i].y),
+              std::min(box.lo.z, net[i].z)};
+    box.hi = {std::max(box.hi.x, net[i].x), std::max(box.hi.y, net[i].y),
+              std::max(box.hi.z, net[i].z)};
+  }
+  return box;
+}
+
+// How far 0 lies outside [lo, hi].
+double gap(double lo, double hi) { return lo > 0.0 ? lo : (hi < 0.0 ? -hi : 0.0); }
+
+double boxDistance(const Box& box, Vec3 p) {
+  const double dx = gap(box.lo.x - p.x, box.hi.x - p.x);
+  const double dy = gap(box.lo.y - p.y, box.hi.y - p.y);
+  const double dz = gap(box.lo.z - p.z, box.hi.z - p.z);
+  return std::sqrt(dx * dx + dy * dy + dz * dz);
+}
+
+// A separating plane: with w the unit direction from p to the mean of the net's corners,
+// every point of the convex hull, hence of the cell, is at least min_i (c_i - p) . w from
+// p (see the contract: near the foot point w tends to the normal, along which the net is
+// O(h^2) thin, so this bound is O(h^2) sharp there; the box in the lateral directions adds
+// nothing, as p projects inside the cell's lateral extent). 0 when p is that mean.
+double separatingPlaneDistance(const Vec3* net, int m, int n, Vec3 p) {
+  const int stride = n + 1;
+  const Vec3 toCell = 0.25 * (net[0] + net[n] + net[m * stride] + net[m * stride + n]) - p;
+  const double length = norm(toCell);
+  if (!(length > 0.0)) return 0.0;
+  const Vec3 w = toCell / length;
+  double least = kInfinity;
+  const int count = (m + 1) * stride;
+  for (int i = 0; i < count; ++i) least = std::min(least, dot(net[i] - p, w));
+  return std::max(0.0, least);
+}
+
+// De Casteljau at 1/2 on b[0], b[s], .., b[n s] into left and right (n + 1 points each,
+// the same stride; they may overwrite b). The same arithmetic as bezier.hpp's subdivideU /
+// subdivideV at t = 1/2 (bit for bit: halving by 0.5 * (a + b) is exact scaling of one
+// rounded sum either way), without its Bernstein2 temporaries, so that building the trees
+// and the search loop do not allocate per cell.
+void halveCurve(const Vec3* b, int n, std::ptrdiff_t s, Vec3* left, Vec3* right) {
+  std::array<Vec3, kMaxPatchDegree + 1> t;
+  for (int i = 0; i <= n; ++i) t[static_cast<std::size_t>(i)] = b[i * s];
+  left[0] = t[0];
+  right[n * s] = t[static_cast<std::size_t>(n)];
+  for (int r = 1; r <= n; ++r) {
+    for (int i = 0; i <= n - r; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      t[k] = 0.5 * (t[k] + t[k + 1]);
+    }
+    left[r * s] = t[0];
+    right[(n - r) * s] = t[static_cast<std::size_t>(n - r)];
+  }
+}
+
+// The four quarters of a net, in the order (u half, v half) = (0,0), (0,1), (1,0), (1,1),
+// written at out, out + size, .. (size = (m + 1)(n + 1); out must not overlap net).
+void halveNet(const Vec3* net, int m, int n, Vec3* out) {
+  const int stride = n + 1;
+  const std::ptrdiff_t size = (m + 1) * stride;
+  Vec3* const lowU = out;
+  Vec3* const highU = out + 2 * size;
+  for (int k = 0; k <= n; ++k) halveCurve(net + k, m, stride, lowU + k, highU + k);  // in u
+  for (Vec3* half : {lowU, highU}) {  // then each half in v, row by row, in place
+    for (int j = 0; j <= m; ++j) {
+      Vec3* row = half + j * stride;
+      halveCurve(row, n, 1, row, row + size);
+    }
+  }
+}
+
+// Value, first and second derivative of the degree-n curve b[0 .. n] at t (b is consumed):
+// de Casteljau down to three points q0, q1, q2; then r = the quadratic's value,
+// r' = n (e1 - e0) from the last level but one, r'' = n (n - 1) (q2 - 2 q1 + q0).
+struct CurveJet {
+  Vec3 d0, d1, d2;
+};
+CurveJet curveJet(Vec3* b, int n, double t) {
+  const double s = 1.0 - t;
+  if (n == 1) return {s * b[0] + t * b[1], b[1] - b[0], {}};
+  for (int count = n + 1; count > 3; --count) {
+    for (int i = 0; i + 1 < count; ++i) b[i] = s * b[i] + t * b[i + 1];
+  }
+  const Vec3 e0 = s * b[0] + t * b[1];
+  const Vec3 e1 = s * b[1] + t * b[2];
+  const double nn = n;
+  return {s * e0 + t * e1, nn * (e1 - e0), (nn * (nn - 1.0)) * (b[2] - 2.0 * b[1] + b[0])};
+}
+
+// r and its partial derivatives to second order at (u, v).
+struct Jet {
+  Vec3 r, ru, rv, ruu, ruv, rvv;
+};
+Jet jetAt(const BezierPatch& patch, double u, double v) {
+  const int m = patch.degreeU;
+  const int n = patch.degreeV;
+  std::array<Vec3, kMaxPatchDegree + 1> row;
+  std::array<Vec3, kMaxPatchDegree + 1> value;
+  std::array<Vec3, kMaxPatchDegree + 1> dv;
+  std::array<Vec3, kMaxPatchDegree + 1> dvv;
+  for (int j = 0; j <= m; ++j) {  // each row along v
+    std::copy_n(patch.control.begin() + j * (n + 1), n + 1, row.begin());
+    const CurveJet c = curveJet(row.data(), n, v);
+    const auto k = static_cast<std::size_t>(j);
+    value[k] = c.d0;
+    dv[k] = c.d1;
+    dvv[k] = c.d2;
+  }
+  const CurveJet a = curveJet(value.data(), m, u);  // then across the rows, along u
+  const CurveJet b = curveJet(dv.data(), m, u);
+  const CurveJet c = curveJet(dvv.data(), m, u);
+  return {a.d0, a.d1, b.d0, a.d2, b.d1, c.d0};
+}
+
+struct Candidate {
+  double distance = kInfinity;
+  std::size_t patch = 0;
+  double u = 0.0;
+  double v = 0.0;
+  Vec3 point;
+};
+
+// A local minimum of f = |r(u, v) - p|^2 / 2 on [0, 1]^2 near (u, v), by a projected Newton
+// iteration: a parameter at its bound whose gradient points outwards is held there (the
+// active set); the Newton step uses the Hessian
+//   [r_u.r_u + d.r_uu, r_u.r_v + d.r_uv; .., r_v.r_v + d.r_vv], d = r - p,
+// when it is positive definite, else the Gauss-Newton matrix [r_u.r_u, r_u.r_v; .., r_v.r_v];
+// steps are clamped to [0, 1]^2 and halved until f decreases. Only ever an upper bound for
+// the search (every point it returns is a surface point), so it need not be globally right.
+Candidate newton(const BezierPatch& patch, std::size_t index, Vec3 p, double u, double v,
+                 const Jet& start) {
+  Jet jet = start;
+  Vec3 d = jet.r - p;
+  double f = dot(d, d);
+  for (int iteration = 0; iteration < 20; ++iteration) {
+    const double gu = dot(d, jet.ru);
+    const double gv = dot(d, jet.rv);
+    const double guu = dot(jet.ru, jet.ru);
+    const double guv = dot(jet.ru, jet.rv);
+    const double gvv = dot(jet.rv, jet.rv);
+    double huu = guu + dot(d, jet.ruu);
+    double huv = guv + dot(d, jet.ruv);
+    double hvv = gvv + dot(d, jet.rvv);
+    const bool freeU = !((u <= 0.0 && gu > 0.0) || (u >= 1.0 && gu < 0.0));
+    const bool freeV = !((v <= 0.0 && gv > 0.0) || (v >= 1.0 && gv < 0.0));
+    double su = 0.0;
+    double sv = 0.0;
+    if (freeU && freeV) {
+      if (!(huu > 0.0 && huu * hvv - huv * huv > 0.0)) {
+        huu = guu;
+        huv = guv;
+        hvv = gvv;
+      }
+      const double det = huu * hvv - huv * huv;
+      if (!(det > 0.0)) break;
+      su = -(hvv * gu - huv * gv) / det;
+      sv = -(huu * gv - huv * gu) / det;
+    } else if (freeU) {
+      const double h = huu > 0.0 ? huu : guu;
+      if (!(h > 0.0)) break;
+      su = -gu / h;
+    } else if (freeV) {
+      const double h = hvv > 0.0 ? hvv : gvv;
+      if (!(h > 0.0)) break;
+      sv = -gv / h;
+    } else {
+      break;  // a corner where f increases into the square: a constrained minimum
+    }
+    bool accepted = false;
+    double nu = u;
+    double nv = v;
+    for (double lambda = 1.0; lambda > 1e-6; lambda *= 0.5) {
+      nu = std::clamp(u + lambda * su, 0.0, 1.0);
+      nv = std::clamp(v + lambda * sv, 0.0, 1.0);
+      const Jet trial = jetAt(patch, nu, nv);
+      const Vec3 dt = trial.r - p;
+      const double ft = dot(dt, dt);
+      if (ft < f) {
+        jet = trial;
+        d = dt;
+        f = ft;
+        accepted = true;
+        break;
+      }
+    }
+    if (!accepted) break;
+    const double moved = std::abs(nu - u) + std::abs(nv - v);
+    u = nu;
+    v = nv;
+    if (moved <= 4.0 * std::numeric_limits<double>::epsilon()) break;
+  }
+  return {std::sqrt(f), index, u, v, jet.r};
+}
+
+// Interval arithmetic on boxes, for the convexity certificate below. Not outward rounded:
+// the certificate takes a relative margin instead (see convexLowerBound).
+struct Interval {
+  double lo = 0.0;
+  double hi = 0.0;
+};
+Interval product(double alo, double ahi, double blo, double bhi) {
+  const double p[4] = {alo * blo, alo * bhi, ahi * blo, ahi * bhi};
+  return {std::min({p[0], p[1], p[2], p[3]}), std::max({p[0], p[1], p[2], p[3]})};
+}
+Interval dotRange(const Box& a, const Box& b) {
+  const Interval x = product(a.lo.x, a.hi.x, b.lo.x, b.hi.x);
+  const Interval y = product(a.lo.y, a.hi.y, b.lo.y, b.hi.y);
+  const Interval z = product(a.lo.z, a.hi.z, b.lo.z, b.hi.z);
+  return {x.lo + y.lo + z.lo, x.hi + y.hi + z.hi};
+}
+double squaredNormLow(const Box& a) {  // min |x|^2 over the box: its distance to 0, squared
+  const double x = gap(a.lo.x, a.hi.x);
+  const double y = gap(a.lo.y, a.hi.y);
+  const double z = gap(a.lo.z, a.hi.z);
+  return x * x + y * y + z * z;
+}
+
+// The box of the control points of the (du, dv) partial derivative of the net's patch
+// (du + dv <= 2): m!/(m-du)! n!/(n-dv)! times the du-th difference along s and the dv-th
+// along t. Zero where the degree is too low.
+Box derivativeBox(const Vec3* net, int m, int n, int du, int dv) {
+  if (du > m || dv > n) return {};
+  const int stride = n + 1;
+  const double weights[3][3] = {{1.0, 0.0, 0.0}, {-1.0, 1.0, 0.0}, {1.0, -2.0, 1.0}};
+  const double factor = (du == 0 ? 1.0 : (du == 1 ? m : m * (m - 1.0))) *
+                        (dv == 0 ? 1.0 : (dv == 1 ? n : n * (n - 1.0)));
+  Box box{{kInfinity, kInfinity, kInfinity}, {-kInfinity, -kInfinity, -kInfinity}};
+  for (int j = 0; j + du <= m; ++j) {
+    for (int k = 0; k + dv <= n; ++k) {
+      Vec3 c;
+      for (int a = 0; a <= du; ++a) {
+        for (int b = 0; b <= dv; ++b) {
+          c = c + (weights[du][a] * weights[dv][b]) * net[(j + a) * stride + k + b];
+        }
+      }
+      c = factor * c;
+      box.lo = {std::min(box.lo.x, c.x), std::min(box.lo.y, c.y), std::min(box.lo.z, c.z)};
+      box.hi = {std::max(box.hi.x, c.x), std::max(box.hi.y, c.y), std::max(box.hi.z, c.z)};
+    }
+  }
+  return box;
+}
+
+// A lower bound on the distance from p to the cell (net on [u0, u0 + h] x [v0, v0 + h] of
+// `patch`) when f = |R(s, t) - p|^2 / 2, R the cell in its own parameters (s, t) in [0, 1]^2,
+// is provably strongly convex there; 0 otherwise. Why: near the foot point the box bounds
+// lag the distance by O(h^2), which for a tolerance t costs about log4(1/t) levels of
+// cells; a convex f is settled at once, from one point x0 of the cell:
+//   f(x) >= f(x0) + g . (x - x0) + lambda/2 |x - x0|^2  for x in the cell,
+// lambda a lower bound of the Hessian's eigenvalues over the cell,
+//   H = [R_s.R_s + d.R_ss, R_s.R_t + d.R_st; .., R_t.R_t + d.R_tt], d = R - p,
+// from interval products of the boxes of the derivative nets (convex hull property); for a
+// symmetric 2x2 matrix lambda_min grows with the diagonal and falls with |off-diagonal|,
+// so the intervals' ends give it. The quadratic's minimum over [0, 1]^2 is separable. x0 is
+// the best point so far clamped into the cell (there g ~ 0 for the cell holding the foot
+// point, and points away from it for its neighbours), else the centre.
+double convexLowerBound(const Vec3* net, const BezierPatch& patch, std::size_t patchIndex,
+                        double u0, double v0, double h, const Candidate& best, Vec3 p) {
+  const int m = patch.degreeU;
+  const int n = patch.degreeV;
+  const auto count = static_cast<std::size_t>((m + 1) * (n + 1));
+  Box d = boxOf(net, count);
+  d = {d.lo - p, d.hi - p};
+  const Box rs = derivativeBox(net, m, n, 1, 0);
+  const Box rt = derivativeBox(net, m, n, 0, 1);
+  const Interval dss = dotRange(d, derivativeBox(net, m, n, 2, 0));
+  const Interval dst = dotRange(d, derivativeBox(net, m, n, 1, 1));
+  const Interval dtt = dotRange(d, derivativeBox(net, m, n, 0, 2));
+  const Interval st = dotRange(rs, rt);
+  const double ss = squaredNormLow(rs);
+  const double tt = squaredNormLow(rt);
+  const double a = ss + dss.lo;
+  const double c = tt + dtt.lo;
+  const double b = std::max(std::abs(st.lo + dst.lo), std::abs(st.hi + dst.hi));
+  if (!(a > 0.0 && c > 0.0 && a * c > b * b)) return 0.0;
+  // lambda_min = (a c - b^2) / ((a + c)/2 + sqrt(((a - c)/2)^2 + b^2)), without cancellation;
+  // less a margin for the rounding of the interval products (1e-12 of their magnitudes, far
+  // above their few-ulp errors).
+  const double margin = 1e-12 * (ss + tt + std::abs(dss.lo) + std::abs(dtt.lo) + 2.0 * b);
+  const double lambda = (a * c - b * b) / (0.5 * (a + c) + std::hypot(0.5 * (a - c), b)) - margin;
+  if (!(lambda > 0.0)) return 0.0;
+  double s0 = 0.5;
+  double t0 = 0.5;
+  if (best.patch == patchIndex && std::isfinite(best.distance)) {
+    s0 = std::clamp((best.u - u0) / h, 0.0, 1.0);
+    t0 = std::clamp((best.v - v0) / h, 0.0, 1.0);
+  }
+  const Jet jet = jetAt(patch, u0 + h * s0, v0 + h * t0);
+  const Vec3 r = jet.r - p;
+  const double gs = h * dot(r, jet.ru);
+  const double gt = h * dot(r, jet.rv);
+  // min over delta in [lo, hi] of g delta + lambda/2 delta^2.
+  const auto least = [lambda](double g, double lo, double hi) {
+    const double delta = std::clamp(-g / lambda, lo, hi);
+    return delta * (g + 0.5 * lambda * delta);
+  };
+  const double f = 0.5 * dot(r, r) + least(gs, -s0, 1.0 - s0) + least(gt, -t0, 1.0 - t0);
+  return std::sqrt(2.0 * std::max(0.0, f));
+}
+
+// A cell of the search: a sub-patch of `patch` on [u0, u0 + h] x [v0, v0 + h], h = 2^-depth.
+// Its net is in the patch's tree (inTree, at `net` = node index) or in the query's arena
+// (at `net` = offset).
+struct Cell {
+  double lower = 0.0;
+  std::uint32_t patch = 0;
+  int depth = 0;
+  bool inTree = false;
+  std::size_t net = 0;
+  double u0 = 0.0;
+  double v0 = 0.0;
+};
+
+struct ByLowerBound {
+  bool operator()(const Cell& a, const Cell& b) const { return a.lower > b.lower; }  // min-heap
+};
+
+struct Scratch {
+  std::vector<Cell> heap;
+  std::vector<Vec3> arena;
+};
+
+void checkSurface(const Surface& surface) {
+  if (surface.patches.empty()) throw Error("surface distance: the surface has no patches");
+  for (std::size_t i = 0; i < surface.patches.size(); ++i) {
+    const BezierPatch& patch = surface.patches[i];
+    if (patch.degreeU < 1 || patch.degreeV < 1 || patch.degreeU > kMaxPatchDegree ||
+        patch.degreeV > kMaxPatchDegree) {
+      throw Error(
+          fmt::format("surface distance: patches[{}]: degrees must be 1 .. {}, got ({}, {})", i,
+                      kMaxPatchDegree, patch.degreeU, patch.degreeV));
+    }
+    const auto expected = static_cast<std::size_t>((patch.degreeU + 1) * (patch.degreeV + 1));
+    if (patch.control.size() != expected) {
+      throw Error(
+          fmt::format("surface distance: patches[{}]: bidegree ({}, {}) needs {} control "
+                      "points, got {}",
+                      i, patch.degreeU, patch.degreeV, expected, patch.control.size()));
+    }
+    for (std::size_t c = 0; c < patch.control.size(); ++c) {
+      if (!isFinite(patch.control[c])) {
+        throw Error(
+            fmt::format("surface distance: patches[{}]: control point {} is not finite", i, c));
+      }
+    }
+  }
+}
+
+PatchTree buildTree(const BezierPatch& patch, int depth) {
+  PatchTree tree;
+  tree.degreeU = patch.degreeU;
+  tree.degreeV = patch.degreeV;
+  tree.stride = patch.control.size();
+  tree.levels = depth + 1;
+  for (const Vec3& c : patch.control) tree.scale = std::max(tree.scale, maxAbs(c));
+  tree.nets.resize(static_cast<std::size_t>(tree.levels));
+  tree.boxes.resize(static_cast<std::size_t>(tree.levels));
+  tree.nets[0] = patch.control;
+  for (int level = 0; level < tree.levels; ++level) {
+    const auto side = std::size_t{1} << level;
+    const auto L = static_cast<std::size_t>(level);
+    std::vector<Box>& boxes = tree.boxes[L];
+    boxes.resize(side * side);
+    for (std::size_t i = 0; i < side * side; ++i) {
+      boxes[i] = boxOf(tree.nets[L].data() + i * tree.stride, tree.stride);
+    }
+    if (level + 1 == tree.levels) break;
+    std::vector<Vec3>& children = tree.nets[L + 1];
+    children.resize(4 * side * side * tree.stride);
+    std::vector<Vec3> quarters(4 * tree.stride);
+    for (std::size_t iu = 0; iu < side; ++iu) {
+      for (std::size_t iv = 0; iv < side; ++iv) {
+        halveNet(tree.nets[L].data() + (iu * side + iv) * tree.stride, patch.degreeU, patch.degreeV,
+                 quarters.data());
+        for (std::size_t a = 0; a < 2; ++a) {
+          for (std::size_t b = 0; b < 2; ++b) {
+            const std::size_t child = (2 * iu + a) * (2 * side) + (2 * iv + b);
+            std::copy_n(quarters.begin() + static_cast<std::ptrdiff_t>((2 * a + b) * tree.stride),
+                        tree.stride,
+                        children.begin() + static_cast<std::ptrdiff_t>(child * tree.stride));
+          }
+        }
+      }
+    }
+  }
+  return tree;
+}
+
+// The branch and bound of the contract.
+ClosestPoint search(const Surface& surface, const std::vector<PatchTree>& trees, double tolerance,
+                    std::size_t maxCells, Vec3 p, double cutoff) {
+  if (!isFinite(p)) {
+    throw Error(
+        fmt::format("surface distance: the query point ({}, {}, {}) is not finite", p.x, p.y, p.z));
+  }
+  if (std::isnan(cutoff)) throw Error("surface distance: the cutoff is NaN");
+  thread_local Scratch scratch;
+  std::vector<Cell>& heap = scratch.heap;
+  std::vector<Vec3>& arena = scratch.arena;
+  heap.clear();
+  arena.clear();
+
+  Candidate best;
+  double setAside = kInfinity;  // the least lower bound of the cells dropped
+  std::size_t cells = 0;
+  const double pScale = maxAbs(p);
+  const auto level = [&] { return std::min(best.distance - tolerance, cutoff); };
+  const auto consider = [&](Vec3 q, std::size_t patch, double u, double v) {
+    const double d = norm(q - p);
+    if (d < best.distance) best = {d, patch, u, v, q};
+  };
+  // The rounding allowance of the contract, for a cell `depth` halvings deep.
+  const auto allowanceOf = [&](const PatchTree& tree, int depth) {
+    return (3.0 * (tree.degreeU + tree.degreeV) * (depth + 1) + 16.0) * kUnitRoundoff *
+           (tree.scale + pScale);
+  };
+  const auto netOf = [&](const Cell& cell) -> const Vec3* {
+    const PatchTree& tree = trees[cell.patch];
+    return cell.inTree
+               ? tree.nets[static_cast<std::size_t>(cell.depth)].data() + cell.net * tree.stride
+               : arena.data() + cell.net;
+  };
+  // Bounds a new cell: its corners are surface points (upper bounds); then its lower bound,
+  // the axis-aligned box first (cheap, precomputed in the tree) and the separating plane
+  // only if the cell survives that; then queued or set aside.
+  const auto offer = [&](Cell cell) {
+    ++cells;
+    const PatchTree& tree = trees[cell.patch];
+    const int m = tree.degreeU;
+    const int n = tree.degreeV;
+    const Vec3* net = netOf(cell);
+    const double h = std::ldexp(1.0, -cell.depth);
+    consider(net[0], cell.patch, cell.u0, cell.v0);
+    consider(net[n], cell.patch, cell.u0, cell.v0 + h);
+    consider(net[m * (n + 1)], cell.patch, cell.u0 + h, cell.v0);
+    consider(net[m * (n + 1) + n], cell.patch, cell.u0 + h, cell.v0 + h);
+    const double allowance = allowanceOf(tree, cell.depth);
+    const Box box = cell.inTree ? tree.boxes[static_cast<std::size_t>(cell.depth)][cell.net]
+                                : boxOf(net, tree.stride);
+    double lower = boxDistance(box, p);
+    if (lower - allowance < level()) lower = std::max(lower, separatingPlaneDistance(net, m, n, p));
+    cell.lower = std::max(0.0, lower - allowance);
+    if (cell.lower >= level()) {
+      setAside = std::min(setAside, cell.lower);
+      return;
+    }
+    heap.push_back(cell);
+    std::push_heap(heap.begin(), heap.end(), ByLowerBound{});
+  };
+
+  for (std::size_t i = 0; i < trees.size(); ++i) {
+    offer({0.0, static_cast<std::uint32_t>(i), 0, true, 0, 0.0, 0.0});
+  }
+  double lowerBound = kInfinity;  // of the cells still queued when the search stops
+  while (!heap.empty()) {
+    std::pop_heap(heap.begin(), heap.end(), ByLowerBound{});
+    const Cell cell = heap.back();
+    heap.pop_back();
+    if (cell.lower >= level()) {  // the least lower bound left: nothing better remains
+      lowerBound = cell.lower;
+      break;
+    }
+    const BezierPatch& patch = surface.patches[cell.patch];
+    const double h = std::ldexp(1.0, -cell.depth);
+    const double uc = cell.u0 + 0.5 * h;
+    const double vc = cell.v0 + 0.5 * h;
+    const Jet jet = jetAt(patch, uc, vc);
+    if (norm(jet.r - p) < best.distance) {
+      const Candidate polished = newton(patch, cell.patch, p, uc, vc, jet);
+      consider(jet.r, cell.patch, uc, vc);
+      consider(polished.point, cell.patch, polished.u, polished.v);
+    }
+    if (cell.lower >= level()) {
+      setAside = std::min(setAside, cell.lower);
+      continue;
+    }
+    const PatchTree& tree = trees[cell.patch];
+    const double convex =
+        convexLowerBound(netOf(cell), patch, cell.patch, cell.u0, cell.v0, h, best, p) -
+        allowanceOf(tree, cell.depth);
+    if (convex >= level()) {
+      setAside = std::min(setAside, std::max(cell.lower, convex));
+      continue;
+    }
+    if (cell.depth >= kMaxCellDepth) {  // cannot be split: its bound stays what it is
+      setAside = std::min(setAside, cell.lower);
+      continue;
+    }
+    if (cells >= maxCells) {
+      lowerBound = cell.lower;
+      break;
+    }
+    const double half = 0.5 * h;
+    const std::size_t stride = tree.stride;
+    if (cell.inTree && cell.depth + 1 < tree.levels) {
+      const auto side = std::size_t{1} << cell.depth;
+      const std::size_t iu = cell.net / side;
+      const std::size_t iv = cell.net % side;
+      for (std::size_t a = 0; a < 2; ++a) {
+        for (std::size_t b = 0; b < 2; ++b) {
+          offer({0.0, cell.patch, cell.depth + 1, true, (2 * iu + a) * (2 * side) + (2 * iv + b),
+                 cell.u0 + static_cast<double>(a) * half, cell.v0 + static_cast<double>(b) * half});
+        }
+      }
+    } else {
+      const std::size_t first = arena.size();
+      arena.resize(first + 4 * stride);  // may move the arena: take the parent's net after
+      halveNet(netOf(cell), tree.degreeU, tree.degreeV, arena.data() + first);
+      for (std::size_t a = 0; a < 2; ++a) {
+        for (std::size_t b = 0; b < 2; ++b) {
+          offer({0.0, cell.patch, cell.depth + 1, false, first + (2 * a + b) * stride,
+                 cell.u0 + static_cast<double>(a) * half, cell.v0 + static_cast<double>(b) * half});
+        }
+      }
+    }
+  }
+
+  ClosestPoint result;
+  result.distance = best.distance;
+  result.patch = best.patch;
+  result.u = best.u;
+  result.v = best.v;
+  result.point = best.point;
+  result.lowerBound = std::max(0.0, std::min({lowerBound, setAside, best.distance}));
+  result.converged = best.distance - result.lowerBound <= tolerance || result.lowerBound >= cutoff;
+  result.cells = cells;
+  return result;
+}
+
+// ---------------------------------------------------------------------------------------
+// Tool-path sampling
+// ---------------------------------------------------------------------------------------
+
+// (e1, e2, normal) coordinates of an arc plane, right-handed, so that counter-clockwise seen
+// from the normal's positive end is increasing atan2(e2, e1): G17 (x, y, z), G18 (z, x, y),
+// G19 (y, z, x).
+Vec3 toPlane(ArcPlane plane, Vec3 a) {
+  switch (plane) {
+    case ArcPlane::xy:
+      return {a.x, a.y, a.z};
+    case ArcPlane::zx:
+      return {a.z, a.x, a.y};
+    case ArcPlane::yz:
+      return {a.y, a.z, a.x};
+  }
+  return a;
+}
+Vec3 fromPlane(ArcPlane plane, Vec3 a) {
+  switch (plane) {
+    case ArcPlane::xy:
+      return {a.x, a.y, a.z};
+    case ArcPlane::zx:
+      return {a.y, a.z, a.x};
+    case ArcPlane::yz:
+      return {a.z, a.x, a.y};
+  }
+  return a;
+}
+
+// One stretch of the path to sample: a line or an arc from `from` to `to`.
+struct Segment {
+  std::size_t pass = 0;
+  std::size_t move = 0;
+  bool onLink = false;
+  bool sampleStart = false;  // the first centre of a retracted pass
+  MoveKind kind = MoveKind::line;
+  Vec3 from;
+  Vec3 to;
+  // Arcs, in plane coordinates: the centre, start angle, signed sweep, radii, heights.
+  ArcPlane plane = ArcPlane::xy;
+  Vec3 center;
+  double angle0 = 0.0;
+  double sweep = 0.0;
+  double radius0 = 0.0;
+  double radius1 = 0.0;
+  double height0 = 0.0;
+  double height1 = 0.0;
+  double length = 0.0;    // an upper bound on the arc length
+  std::size_t steps = 0;  // intervals between samples
+};
+
+Vec3 positionOn(const Segment& s, std::size_t i) {
+  if (i == 0) return s.from;
+  if (i == s.steps) return s.to;  // vertices exactly
+  const double t = static_cast<double>(i) / static_cast<double>(s.steps);
+  if (s.kind == MoveKind::line) return s.from + t * (s.to - s.from);
+  const double angle = s.angle0 + t * s.sweep;
+  const double radius = s.radius0 + t * (s.radius1 - s.radius0);
+  return fromPlane(s.plane,
+                   {s.center.x + radius * std::cos(angle), s.center.y + radius * std::sin(angle),
+                    s.height0 + t * (s.height1 - s.height0)});
+}
+
+std::string where(std::size_t pass, std::size_t move, bool onLink) {
+  return onLink ? fmt::format("passes[{}] (link)", pass)
+                : fmt::format("passes[{}].moves[{}]", pass, move);
+}
+
+void requireFinite(Vec3 a, const std::string& what) {
+  if (!isFinite(a)) {
+    throw Error(fmt::format("gougeCheck: {} is not finite: ({}, {}, {})", what, a.x, a.y, a.z));
+  }
+}
+
+Segment arcSegment(Segment s, const ToolMove& move) {
+  const std::string name = where(s.pass, s.move, false);
+  requireFinite(move.center, name + ".center");
+  s.plane = move.plane;
+  const Vec3 a = toPlane(move.plane, s.from);
+  const Vec3 b = toPlane(move.plane, s.to);
+  s.center = toPlane(move.plane, move.center);
+  s.radius0 = std::hypot(a.x - s.center.x, a.y - s.center.y);
+  s.radius1 = std::hypot(b.x - s.center.x, b.y - s.center.y);
+  const double radius = std::max(s.radius0, s.radius1);
+  if (!(s.radius0 > 0.0) || !(s.radius1 > 0.0)) {
+    throw Error(
+        fmt::format("gougeCheck: {}: arc end at its centre (radius {} at the start, {} at "
+                    "the end)",
+                    name, s.radius0, s.radius1));
+  }
+  if (s.from == s.to) {
+    throw Error(
+        fmt::format("gougeCheck: {}: arc starts where it ends (a full circle is not "
+                    "allowed)",
+                    name));
+  }
+  const double slack = 1e-6 * radius;  // "the same distance, within rounding" (toolpath.hpp)
+  if (std::abs(s.radius0 - s.radius1) > slack) {
+    throw Error(
+        fmt::format("gougeCheck: {}: arc ends at different distances from the centre: "
+                    "{} and {}",
+                    name, s.radius0, s.radius1));
+  }
+  if (std::abs(a.z - s.center.z) > slack || std::abs(b.z - s.center.z) > slack) {
+    throw Error(
+        fmt::format("gougeCheck: {}: arc ends and centre are not in one plane normal to "
+                    "its axis ({}, {} and {} along it)",
+                    name, a.z, b.z, s.center.z));
+  }
+  s.height0 = a.z;
+  s.height1 = b.z;
+  s.angle0 = std::atan2(a.y - s.center.y, a.x - s.center.x);
+  const double angle1 = std::atan2(b.y - s.center.y, b.x - s.center.x);
+  // Counter-clockwise turns through increasing angle; the sweep is in (0, 2 pi].
+  double sweep = move.clockwise ? s.angle0 - angle1 : angle1 - s.angle0;
+  if (sweep <= 0.0) sweep += 2.0 * std::numbers::pi;
+  s.sweep = move.clockwise ? -sweep : sweep;
+  // |d/dt (r cos, r sin, z)| <= sqrt((r_max sweep)^2 + dr^2 + dz^2) pointwise.
+  s.length = std::sqrt(radius * sweep * radius * sweep +
+                       (s.radius1 - s.radius0) * (s.radius1 - s.radius0) +
+                       (s.height1 - s.height0) * (s.height1 - s.height0));
+  return s;
+}
+
+std::vector<Segment> segmentsOf(const ToolPath& path) {
+  std::vector<Segment> segments;
+  Vec3 previousEnd;
+  for (std::size_t i = 0; i < path.passes.size(); ++i) {
+    const ToolPass& pass = path.passes[i];
+    requireFinite(pass.start, fmt::format("passes[{}].start", i));
+    const bool linked = i > 0 && !pass.retractBefore;
+    Segment first;
+    first.pass = i;
+    if (linked) {
+      first.onLink = true;
+      first.from = previousEnd;
+      first.to = pass.start;
+      first.length = norm(pass.start - previousEnd);
+      segments.push_back(first);
+    } else {  // the pass's first centre, alone: a zero-length line sampled at its start
+      first.sampleStart = true;
+      first.from = pass.start;
+      first.to = pass.start;
+      segments.push_back(first);
+    }
+    Vec3 at = pass.start;
+    for (std::size_t k = 0; k < pass.moves.size(); ++k) {
+      const ToolMove& move = pass.moves[k];
+      requireFinite(move.end, where(i, k, false) + ".end");
+      Segment s;
+      s.pass = i;
+      s.move = k;
+      s.kind = move.kind;
+      s.from = at;
+      s.to = move.end;
+      if (move.kind == MoveKind::arc) {
+        s = arcSegment(s, move);
+      } else {
+        s.length = norm(move.end - at);
+      }
+      segments.push_back(s);
+      at = move.end;
+    }
+    previousEnd = at;
+  }
+  return segments;
+}
+
+}  // namespace
+
+SurfaceDistance::SurfaceDistance(const Surface& surface, const DistanceOptions& options)
+    : surface_(surface), options_(options) {
+  checkSurface(surface_);
+  if (!(options.tolerance >= 0.0) || !std::isfinite(options.tolerance)) {
+    throw Error(fmt::format("surface distance: the tolerance must be finite and >= 0, got {}",
+                            options.tolerance));
+  }
+  if (options.treeDepth < 0 || options.treeDepth > kMaxTreeDepth) {
+    throw Error(fmt::format("surface distance: treeDepth must be 0 .. {}, got {}", kMaxTreeDepth,
+                            options.treeDepth));
+  }
+  if (options.maxCells < 1) throw Error("surface distance: maxCells must be >= 1");
+  tolerance_ = options.tolerance > 0.0 ? options.tolerance : 1e-9 * surfaceScale(surface_);
+  // A surface collapsed to the origin has scale 0; any positive tolerance will do there.
+  if (!(tolerance_ > 0.0)) tolerance_ = std::numeric_limits<double>::min();
+  trees_.reserve(surface_.patches.size());
+  for (const BezierPatch& patch : surface_.patches) {
+    trees_.push_back(buildTree(patch, options.treeDepth));
+  }
+}
+
+SurfaceDistance::~SurfaceDistance() = default;
+SurfaceDistance::SurfaceDistance(const SurfaceDistance&) = default;
+SurfaceDistance::SurfaceDistance(SurfaceDistance&&) noexcept = default;
+SurfaceDistance& SurfaceDistance::operator=(const SurfaceDistance&) = default;
+SurfaceDistance& SurfaceDistance::operator=(SurfaceDistance&&) noexcept = default;
+
+ClosestPoint SurfaceDistance::closest(Vec3 p) const { return closest(p, kInfinity); }
+
+ClosestPoint SurfaceDistance::closest(Vec3 p, double cutoff) const {
+  return search(surface_, trees_, tolerance_, options_.maxCells, p, cutoff);
+}
+
+double distanceToSurface(const Surface& surface, Vec3 p, const DistanceOptions& options) {
+  return closestPointOnSurface(surface, p, options).distance;
+}
+
+ClosestPoint closestPointOnSurface(const Surface& surface, Vec3 p, const DistanceOptions& options) {
+  return SurfaceDistance(surface, options).closest(p);
+}
+
+GougeReport gougeCheck(const Surface& surface, const ToolPath& path, double sampleSpacing,
+                       const GougeOptions& options) {
+  return gougeCheck(SurfaceDistance(surface, options.distance), path, sampleSpacing, options);
+}
+
+GougeReport gougeCheck(const SurfaceDistance& distance, const ToolPath& path, double sampleSpacing,
+                       const GougeOptions& options) {
+  if (!(sampleSpacing > 0.0) || !std::isfinite(sampleSpacing)) {
+    throw Error(fmt::format(
+        "gougeCheck: the sample spacing must be a positive finite length, got {}", sampleSpacing));
+  }
+  const double radius = path.toolRadius;
+  if (!(radius > 0.0) || !std::isfinite(radius)) {
+    throw Error(
+        fmt::format("gougeCheck: the tool radius must be positive and finite, got {}", radius));
+  }
+  if (path.units != distance.surface().units) {
+    throw Error(fmt::format("gougeCheck: the tool path is in {} but the surface in {}",
+                            unitsName(path.units), unitsName(distance.surface().units)));
+  }
+  if (std::isnan(options.depthThreshold)) throw Error("gougeCheck: the depth threshold is NaN");
+
+  std::vector<Segment> segments = segmentsOf(path);
+  // Count before sampling: a tiny spacing on a long path must fail fast, not run for hours.
+  double total = 0.0;
+  double length = 0.0;
+  double maxGap = 0.0;
+  for (Segment& s : segments) {
+    const double steps = std::ceil(s.length / sampleSpacing);
+    total += steps + (s.sampleStart ? 1.0 : 0.0);
+    length += s.length;
+    if (total > static_cast<double>(options.maxSamples)) {
+      throw Error(
+          fmt::format("gougeCheck: a sample spacing of {} needs more than {} samples on "
+                      "this path (more than {} of path length so far); use a larger spacing "
+                      "or raise maxSamples",
+                      sampleSpacing, options.maxSamples, length));
+    }
+    s.steps = static_cast<std::size_t>(steps);
+    if (s.steps > 0) maxGap = std::max(maxGap, s.length / static_cast<double>(s.steps));
+  }
+
+  GougeReport report;
+  report.depthThreshold = options.depthThreshold;
+  report.maxSampleGap = maxGap;
+  report.tolerance = distance.tolerance();
+  double least = kInfinity;        // the least distance found
+  double leastProven = kInfinity;  // the least lower bound of any sample's distance
+  const double countBelow = radius - options.depthThreshold;
+  for (const Segment& s : segments) {
+    for (std::size_t i = s.sampleStart ? 0 : 1; i <= s.steps; ++i) {
+      const Vec3 center = positionOn(s, i);
+      // A sample farther than both the least distance so far and R - threshold changes
+      // nothing in the report: let the search drop it early. A retracted pass's first centre
+      // is found in full, for the test of its side.
+      const double cutoff = s.sampleStart ? kInfinity : std::max(least, countBelow);
+      const ClosestPoint contact = distance.closest(center, cutoff);
+      ++report.samples;
+      leastProven = std::min(leastProven, contact.lowerBound);
+      if (contact.distance < countBelow) ++report.samplesDeeperThanThreshold;
+      if (contact.distance < least) {
+        least = contact.distance;
+        report.deepest = {s.pass, s.move, s.onLink, center, contact};
+      }
+      if (s.sampleStart && contact.distance > report.tolerance) {
+        // Material side: opposite the upward normal at the closest point (see the contract).
+        Vec3 up = normalVector(distance.surface().patches[contact.patch], contact.u, contact.v);
+        if (up.z < 0.0) up = -up;
+        if (up.z > 0.0 && dot(center - contact.point, up) < 0.0) ++report.passStartsBelowSurface;
+      }
+    }
+  }
+  if (report.samples > 0) {
+    report.signedMaxDepth = radius - least;
+    report.maxDepth = std::max(0.0, report.signedMaxDepth);
+    report.depthBound = radius - leastProven + 0.5 * maxGap;
+  }
+  return report;
+}
+
+}  // namespace scallop

@@ -1,0 +1,262 @@
+#include "scallop/paths_output.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "scallop/bezier.hpp"
+#include "scallop/error.hpp"
+#include "json_format.hpp"
+#include "svg_format.hpp"
+
+namespace scallop {
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+Json vec(const Vec3& p) { return Json::array({p.x, p.y, p.z}); }
+
+const char* planeName(ArcPlane plane) {
+  switch (plane) {
+    case ArcPlane::xy: return "xy";
+    case ArcPlane::zx: return "zx";
+    case ArcPlane::yz: return "yz";
+  }
+  return "xy";
+}
+
+Json moveJson(const ToolMove& move) {
+  Json json;
+  if (move.kind == MoveKind::line) {
+    json["line"] = vec(move.end);
+  } else {
+    Json arc;
+    arc["end"] = vec(move.end);
+    arc["center"] = vec(move.center);
+    arc["plane"] = planeName(move.plane);
+    arc["clockwise"] = move.clockwise;
+    json["arc"] = arc;
+  }
+  return json;
+}
+
+// The two in-plane axes (a, b) of an arc plane, ordered so that a x b is the plane's positive
+// normal: xy -> (x, y), zx -> (z, x), yz -> (y, z).
+void planeAxes(ArcPlane plane, Vec3& a, Vec3& b) {
+  switch (plane) {
+    case ArcPlane::xy: a = {1, 0, 0}, b = {0, 1, 0}; return;
+    case ArcPlane::zx: a = {0, 0, 1}, b = {1, 0, 0}; return;
+    case ArcPlane::yz: a = {0, 1, 0}, b = {0, 0, 1}; return;
+  }
+}
+
+// Points along an arc move from `from`, for drawing: counter-clockwise in (a, b) is positive
+// angle; clockwise (G2) is negative.
+void appendArc(const Vec3& from, const ToolMove& move, std::vector<Vec3>& out) {
+  Vec3 a, b;
+  planeAxes(move.plane, a, b);
+  const Vec3 s = from - move.center, e = move.end - move.center;
+  const double a0 = std::atan2(dot(s, b), dot(s, a));
+  double sweep = std::atan2(dot(e, b), dot(e, a)) - a0;
+  if (move.clockwise) {
+    while (sweep >= 0.0) sweep -= 2.0 * std::numbers::pi;
+  } else {
+    while (sweep <= 0.0) sweep += 2.0 * std::numbers::pi;
+  }
+  const double radius = norm(s);
+  const Vec3 normal = cross(a, b);
+  const double level = dot(from, normal);
+  const int steps = std::max(2, static_cast<int>(std::ceil(std::abs(sweep) / (5.0 * std::numbers::pi / 180.0))));
+  for (int i = 1; i < steps; ++i) {
+    const double t = a0 + sweep * i / steps;
+    Vec3 p = move.center + radius * (std::cos(t) * a + std::sin(t) * b);
+    p = p + (level - dot(p, normal)) * normal;
+    out.push_back(p);
+  }
+  out.push_back(move.end);
+}
+
+std::vector<Vec3> passPoints(const ToolPass& pass) {
+  std::vector<Vec3> points{pass.start};
+  for (const ToolMove& move : pass.moves) {
+    if (move.kind == MoveKind::line) {
+      points.push_back(move.end);
+    } else {
+      appendArc(points.back(), move, points);
+    }
+  }
+  return points;
+}
+
+// The title as SVG text: the five XML specials escaped.
+std::string escaped(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      case '\'': out += "&apos;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+struct View {
+  Vec3 right, up;
+  Vec2 project(const Vec3& p) const { return {dot(p, right), -dot(p, up)}; }
+};
+
+}  // namespace
+
+std::string pathsToJson(const PathsReport& report, const ToolPath& path) {
+  Json document;
+  document["strategy"] = report.strategy;
+  document["source"] = report.source;
+  document["units"] = std::string(unitsName(report.units));
+  document["tool_radius"] = report.toolRadius;
+  document["spacing"] = report.spacing;
+  document["scallop_height"] = report.scallopHeight ? Json(*report.scallopHeight) : Json(nullptr);
+  document["plane_normal"] = vec(report.planeNormal);
+  document["alpha_deg"] = report.alphaRad * 180.0 / std::numbers::pi;
+  if (report.feedAngleRad) document["feed_angle_deg"] = *report.feedAngleRad * 180.0 / std::numbers::pi;
+  Json stats;
+  stats["planes"] = report.stats.planes;
+  stats["components"] = report.stats.components;
+  stats["contact_length"] = report.stats.contactLength;
+  stats["centre_length"] = report.stats.centreLength;
+  stats["touch_points"] = report.stats.touchPoints;
+  stats["passes"] = path.passes.size();
+  document["stats"] = stats;
+  if (report.gouge) {
+    Json gouge;
+    gouge["max_depth"] = report.gouge->maxDepth;
+    gouge["signed_max_depth"] = report.gouge->signedMaxDepth;
+    gouge["depth_bound"] = report.gouge->depthBound;
+    gouge["sample_spacing"] = report.gouge->sampleSpacing;
+    gouge["samples"] = report.gouge->samples;
+    gouge["where"] = vec(report.gouge->where);
+    gouge["pass"] = report.gouge->pass;
+    document["gouge"] = gouge;
+  } else {
+    document["gouge"] = nullptr;
+  }
+  if (report.orientation) {
+    Json orientation;
+    orientation["normal"] = vec(report.orientation->normal);
+    orientation["alpha_deg"] = report.orientation->alphaRad * 180.0 / std::numbers::pi;
+    orientation["certified"] = report.orientation->certified;
+    orientation["boundary_segments"] = report.orientation->boundarySegments;
+    orientation["seconds"] = report.orientation->seconds;
+    document["orientation"] = orientation;
+  } else {
+    document["orientation"] = nullptr;
+  }
+  document["seconds"] = report.seconds;
+  Json passes = Json::array();
+  for (const ToolPass& pass : path.passes) {
+    for (const ToolMove& move : pass.moves) {
+      if (!std::isfinite(move.end.x) || !std::isfinite(move.end.y) || !std::isfinite(move.end.z))
+        throw Error("cannot write the tool path: a position is not finite");
+    }
+    Json p;
+    p["retract_before"] = pass.retractBefore;
+    p["start"] = vec(pass.start);
+    Json moves = Json::array();
+    for (const ToolMove& move : pass.moves) moves.push_back(moveJson(move));
+    p["moves"] = moves;
+    passes.push_back(p);
+  }
+  // Each pass on one line: "passes" is an array, which the layout keeps compact per element.
+  document["passes"] = passes;
+  return json::format(document);
+}
+
+std::string pathsSvg(const Surface& surface, const std::vector<std::vector<Vec3>>& contactCurves,
+                     const ToolPath& path, const std::string& title, bool planView) {
+  using svg::px;
+  View view;
+  if (planView) {
+    view = {{1, 0, 0}, {0, 1, 0}};
+  } else {
+    // Looking from the front left and above (azimuth -60 degrees, elevation 30 degrees).
+    const double az = -60.0 * std::numbers::pi / 180.0, el = 30.0 * std::numbers::pi / 180.0;
+    const Vec3 eye{std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el)};
+    const Vec3 right = normalized(cross(Vec3{0, 0, 1}, eye));
+    view = {right, cross(eye, right)};
+  }
+  // Surface iso-parameter lines, 11 each way per patch.
+  std::vector<std::vector<Vec3>> iso;
+  for (const BezierPatch& patch : surface.patches) {
+    for (int i = 0; i <= 10; ++i) {
+      std::vector<Vec3> a, b;
+      for (int j = 0; j <= 40; ++j) {
+        a.push_back(point(patch, i / 10.0, j / 40.0));
+        b.push_back(point(patch, j / 40.0, i / 10.0));
+      }
+      iso.push_back(std::move(a));
+      iso.push_back(std::move(b));
+    }
+  }
+  std::vector<std::vector<Vec3>> passes;
+  for (const ToolPass& pass : path.passes) passes.push_back(passPoints(pass));
+  // Page frame from everything drawn.
+  double x0 = std::numeric_limits<double>::infinity(), x1 = -x0, y0 = x0, y1 = -x0;
+  using Lines = std::vector<std::vector<Vec3>>;
+  for (const Lines* group : {static_cast<const Lines*>(&iso), &contactCurves, static_cast<const Lines*>(&passes)})
+    for (const auto& line : *group)
+      for (const Vec3& p : line) {
+        const Vec2 q = view.project(p);
+        x0 = std::min(x0, q.x), x1 = std::max(x1, q.x), y0 = std::min(y0, q.y), y1 = std::max(y1, q.y);
+      }
+  if (!(x1 > x0) || !(y1 > y0)) throw Error("cannot draw the tool path: nothing to draw");
+  constexpr double kWidth = 900.0, kMargin = 20.0, kTop = 60.0;
+  const double scale = (kWidth - 2 * kMargin) / std::max(x1 - x0, (y1 - y0) * 1.2);
+  const double height = kTop + (y1 - y0) * scale + 2 * kMargin;
+  auto polyline = [&](const std::vector<Vec3>& line, const char* cls) {
+    std::string s = fmt::format("<polyline class=\"{}\" points=\"", cls);
+    for (std::size_t i = 0; i < line.size(); ++i) {
+      const Vec2 q = view.project(line[i]);
+      s += fmt::format("{}{},{}", i ? " " : "", px(kMargin + (q.x - x0) * scale),
+                       px(kTop + (q.y - y0) * scale));
+    }
+    return s + "\"/>\n";
+  };
+  std::string out = fmt::format(
+      "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{0}\" height=\"{1}\" viewBox=\"0 0 {0} {1}\">\n"
+      "<style>\n"
+      "text {{ font-family: sans-serif; font-size: 13px; fill: #222222; }}\n"
+      ".title {{ font-size: 15px; font-weight: bold; }}\n"
+      "polyline {{ fill: none; stroke-linejoin: round; }}\n"
+      ".iso {{ stroke: #b8b8b8; stroke-width: 0.6; }}\n"
+      ".contact {{ stroke: #1f5fbf; stroke-width: 0.8; }}\n"
+      ".centre {{ stroke: #c0392b; stroke-width: 0.8; }}\n"
+      ".rapid {{ stroke: #666666; stroke-width: 0.5; stroke-dasharray: 3 3; }}\n"
+      "</style>\n"
+      "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n",
+      px(kWidth), px(height));
+  out += fmt::format("<text class=\"title\" x=\"{}\" y=\"22\">{}</text>\n", px(kMargin), escaped(title));
+  out += fmt::format(
+      "<text x=\"{}\" y=\"42\">{}: grey surface iso-lines, blue contact curves (sections), red "
+      "tool-centre passes, dashed rapid moves</text>\n",
+      px(kMargin), planView ? "plan view" : "axonometric view");
+  for (const auto& line : iso) out += polyline(line, "iso");
+  for (const auto& line : contactCurves) out += polyline(line, "contact");
+  for (std::size_t i = 0; i < passes.size(); ++i) {
+    if (i > 0 && path.passes[i].retractBefore)
+      out += polyline({passes[i - 1].back(), passes[i].front()}, "rapid");
+    out += polyline(passes[i], "centre");
+  }
+  out += "</svg>\n";
+  return out;
+}
+
+}  // namespace scallop

@@ -1,0 +1,579 @@
+#include "scallop/raster.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <queue>
+#include <utility>
+
+#include <fmt/format.h>
+
+#include "scallop/bezier.hpp"
+#include "scallop/error.hpp"
+#include "scallop/path_sampling.hpp"
+
+namespace scallop {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+void requirePositive(const char* what, double value) {
+  if (!(value > 0.0) || !std::isfinite(value))
+    throw Error(fmt::format("{} must be a positive number, got {}", what, value));
+}
+
+void requireNonNegative(const char* what, double value) {
+  if (!(value >= 0.0) || !std::isfinite(value))
+    throw Error(fmt::format("{} must be zero (the default) or a positive number, got {}", what,
+                            value));
+}
+
+// The raster frame: feed d, plane normal e, z up; (d, e, z^) is right-handed (d x e = z^).
+struct Frame {
+  Vec3 d;
+  Vec3 e;
+  bool alongX = false;  // d = +-x exactly: arcs in the zx plane (G18)
+  bool alongY = false;  // d = +-y exactly: arcs in the yz plane (G19)
+
+  // P(s, z) = s d + w e + z z^. With d and e snapped to axes every product is exact, so
+  // the coordinate normal to an arc's plane is w (or -w) bit for bit at every point.
+  Vec3 at(double s, double w, double z) const { return s * d + w * e + Vec3{0.0, 0.0, z}; }
+  Vec3 at(const Point2& p, double w) const { return at(p.x, w, p.z); }
+};
+
+Frame frameFor(double angle) {
+  const double c = std::cos(angle);
+  const double s = std::sin(angle);
+  Frame f;
+  if (std::abs(s) < 1e-12) {
+    f.d = {c > 0.0 ? 1.0 : -1.0, 0.0, 0.0};
+    f.alongX = true;
+  } else if (std::abs(c) < 1e-12) {
+    f.d = {0.0, s > 0.0 ? 1.0 : -1.0, 0.0};
+    f.alongY = true;
+  } else {
+    f.d = {c, s, 0.0};
+  }
+  f.e = {0.0 - f.d.y, f.d.x, 0.0};  // 0 - 0 is +0: no "-0" in messages
+  return f;
+}
+
+// ---------------------------------------------------------------------------------------
+// Sections to chains
+// ---------------------------------------------------------------------------------------
+
+// One section curve as a chain in its plane, oriented so that s increases, with the
+// section points (for naming places in errors).
+struct OrientedCurve {
+  std::size_t curve = 0;
+  std::vector<Point2> points;       // (s, z)
+  std::vector<SectionPoint> where;  // the same vertices, on the surface
+};
+
+[[noreturn]] void throwNotGraph(const Frame& f, double w, const std::string& what,
+                                const SectionPoint& p) {
+  throw Error(fmt::format(
+      "the surface is not a graph over the raster direction d = ({:.6g}, {:.6g}, 0): in the "
+      "plane e . r = {:.9g} (e = ({:.6g}, {:.6g}, 0)) {} at patch {} (u, v) = ({:.6g}, {:.6g}), "
+      "point ({:.6g}, {:.6g}, {:.6g})",
+      f.d.x, f.d.y, w, f.e.x, f.e.y, what, p.patch, p.u, p.v, p.point.x, p.point.y, p.point.z));
+}
+
+OrientedCurve orientCurve(const SectionCurve& curve, std::size_t index, const Frame& f, double w,
+                          double tau) {
+  OrientedCurve out;
+  out.curve = index;
+  out.where = curve.points;
+  if (curve.closed) {
+    // A closed section has a largest s where it turns back; name that point.
+    const auto extreme = std::max_element(
+        out.where.begin(), out.where.end(), [&](const SectionPoint& a, const SectionPoint& b) {
+          return dot(f.d, a.point) < dot(f.d, b.point);
+        });
+    throwNotGraph(f, w, "the section is a closed loop; it turns back in s", *extreme);
+  }
+  if (dot(f.d, out.where.back().point) < dot(f.d, out.where.front().point))
+    std::reverse(out.where.begin(), out.where.end());
+  out.points.reserve(out.where.size());
+  double highest = -kInf;
+  std::size_t highestAt = 0;
+  for (std::size_t i = 0; i < out.where.size(); ++i) {
+    const Vec3& p = out.where[i].point;
+    double s = dot(f.d, p);
+    if (s < highest - tau)
+      throwNotGraph(f, w,
+                    fmt::format("the section reaches a largest s and turns back (by more "
+                                "than the tolerance {:.3g})",
+                                tau),
+                    out.where[highestAt]);
+    // Back-steps within tau are rounding on a vertical wall: flatten them so the chain is
+    // monotone, as scallopHull requires.
+    if (s <= highest) {
+      s = highest;
+    } else {
+      highest = s;
+      highestAt = i;
+    }
+    out.points.push_back({s, p.z});
+  }
+  return out;
+}
+
+// The chains of one plane: its curves sorted by s, checked to lie side by side, and those
+// less than 2R apart merged through bridge vertices (see the contract).
+std::vector<RasterChain> planeChains(const PlaneSection& section, const Frame& f, double w,
+                                     double radius, double tau) {
+  std::vector<OrientedCurve> curves;
+  for (std::size_t i = 0; i < section.curves.size(); ++i)
+    if (section.curves[i].points.size() >= 2)  // a lone point has nothing to follow
+      curves.push_back(orientCurve(section.curves[i], i, f, w, tau));
+  std::sort(curves.begin(), curves.end(), [](const OrientedCurve& a, const OrientedCurve& b) {
+    return a.points.front().x < b.points.front().x;
+  });
+  std::vector<RasterChain> chains;
+  double reach = -kInf;        // the largest s of the curves so far
+  const OrientedCurve* reachCurve = nullptr;
+  for (const OrientedCurve& c : curves) {
+    const double begin = c.points.front().x;
+    if (reachCurve != nullptr && begin < reach - tau) {
+      // Two sheets over the same s: name the lower-s start that lies under/over the other.
+      throwNotGraph(f, w,
+                    fmt::format("two sheets of the surface lie over s in [{:.6g}, {:.6g}] "
+                                "(section curves {} and {}); one begins",
+                                begin, reach, reachCurve->curve, c.curve),
+                    c.where.front());
+    }
+    if (chains.empty() || begin - reach >= 2.0 * radius) {
+      chains.push_back({});
+      chains.back().chain = c.points;
+    } else {
+      // A gap narrower than the ball: bridge it (the ball cannot reach the floor).
+      Chain& chain = chains.back().chain;
+      const Point2 a = chain.back();
+      const double floor = std::min(a.z, c.points.front().z) - 2.0 * radius;
+      chain.push_back({a.x, floor});
+      for (std::size_t i = 0; i < c.points.size(); ++i) {
+        const Point2 p{std::max(c.points[i].x, a.x), c.points[i].z};
+        if (i == 0) chain.push_back({p.x, floor});
+        chain.push_back(p);
+      }
+    }
+    chains.back().curves.push_back(c.curve);
+    if (c.points.back().x > reach) {
+      reach = c.points.back().x;
+      reachCurve = &c;
+    }
+  }
+  return chains;
+}
+
+// ---------------------------------------------------------------------------------------
+// Passes
+// ---------------------------------------------------------------------------------------
+
+// The hull's tool-centre path in 3D. Feeds along an axis keep the arcs; other feeds get the
+// circumscribed polygon, which never passes inside the true path (path_sampling.hpp).
+ToolPass passFromHull(const ScallopHull& hull, const Frame& f, double w, double arcTolerance) {
+  ToolPass pass;
+  const std::vector<PathElement>& path = hull.toolpath;
+  if (f.alongX || f.alongY) {
+    pass.start = f.at(path.front().start, w);
+    // The hull's arcs turn clockwise in (s right, z up): a positive rotation about e, since
+    // d x z^ = -e. Seen from the positive principal axis that is clockwise (G2) iff e points
+    // the other way (see the contract).
+    const ArcPlane plane = f.alongX ? ArcPlane::zx : ArcPlane::yz;
+    const Vec3 axis = f.alongX ? Vec3{0.0, 1.0, 0.0} : Vec3{1.0, 0.0, 0.0};
+    const bool clockwise = dot(f.e, axis) < 0.0;
+    for (const PathElement& el : path) {
+      if (el.start == el.end) continue;  // nothing to move (and no full-circle arcs)
+      ToolMove move;
+      move.end = f.at(el.end, w);
+      if (el.kind == PathElementKind::arc) {
+        move.kind = MoveKind::arc;
+        move.center = f.at(el.center, w);
+        move.plane = plane;
+        move.clockwise = clockwise;
+      }
+      pass.moves.push_back(move);
+    }
+  } else {
+    const std::vector<Point2> polyline = samplePath(path, arcTolerance);
+    pass.start = f.at(polyline.front(), w);
+    for (std::size_t i = 1; i < polyline.size(); ++i)
+      pass.moves.push_back({MoveKind::line, f.at(polyline[i], w), {}, ArcPlane::xy, true});
+  }
+  return pass;
+}
+
+// The same path run backwards: moves in reverse order, each ending where its predecessor
+// began, arcs turning the other way.
+ToolPass reversedPass(const ToolPass& pass) {
+  ToolPass out;
+  out.retractBefore = pass.retractBefore;
+  out.start = pass.moves.empty() ? pass.start : pass.moves.back().end;
+  for (std::size_t i = pass.moves.size(); i-- > 0;) {
+    ToolMove move = pass.moves[i];
+    move.end = i == 0 ? pass.start : pass.moves[i - 1].end;
+    if (move.kind == MoveKind::arc) move.clockwise = !move.clockwise;
+    out.moves.push_back(move);
+  }
+  return out;
+}
+
+Vec3 passEnd(const ToolPass& pass) { return pass.moves.empty() ? pass.start : pass.moves.back().end; }
+
+// ---------------------------------------------------------------------------------------
+// Link heights: a bound on the surface's height near a horizontal segment
+// ---------------------------------------------------------------------------------------
+
+struct Box {
+  double x0, x1, y0, y1, z0, z1;
+};
+
+Box controlBox(const BezierPatch& patch) {
+  Box b{kInf, -kInf, kInf, -kInf, kInf, -kInf};
+  for (const Vec3& p : patch.control) {
+    b.x0 = std::min(b.x0, p.x), b.x1 = std::max(b.x1, p.x);
+    b.y0 = std::min(b.y0, p.y), b.y1 = std::max(b.y1, p.y);
+    b.z0 = std::min(b.z0, p.z), b.z1 = std::max(b.z1, p.z);
+  }
+  return b;
+}
+
+double pointSegmentDistance(Vec2 p, Vec2 a, Vec2 b) {
+  const Vec2 ab = b - a;
+  const double len2 = dot(ab, ab);
+  const double t = len2 > 0.0 ? std::clamp(dot(p - a, ab) / len2, 0.0, 1.0) : 0.0;
+  return norm(p - (a + t * ab));
+}
+
+bool segmentsCross(Vec2 a, Vec2 b, Vec2 c, Vec2 d) {
+  const double d1 = cross(b - a, c - a), d2 = cross(b - a, d - a);
+  const double d3 = cross(d - c, a - c), d4 = cross(d - c, b - c);
+  return ((d1 <= 0.0 && d2 >= 0.0) || (d1 >= 0.0 && d2 <= 0.0)) &&
+         ((d3 <= 0.0 && d4 >= 0.0) || (d3 >= 0.0 && d4 <= 0.0));
+}
+
+// Horizontal distance from the segment [a, b] to the box's footprint (0 if they meet).
+double segmentBoxDistance(Vec2 a, Vec2 b, const Box& box) {
+  const auto inside = [&](Vec2 p) {
+    return p.x >= box.x0 && p.x <= box.x1 && p.y >= box.y0 && p.y <= box.y1;
+  };
+  if (inside(a) || inside(b)) return 0.0;
+  const Vec2 corners[4] = {{box.x0, box.y0}, {box.x1, box.y0}, {box.x1, box.y1}, {box.x0, box.y1}};
+  double best = kInf;
+  for (int i = 0; i < 4; ++i) {
+    const Vec2 c = corners[i], d = corners[(i + 1) % 4];
+    if (segmentsCross(a, b, c, d)) return 0.0;
+    best = std::min({best, pointSegmentDistance(c, a, b), pointSegmentDistance(a, c, d),
+                     pointSegmentDistance(b, c, d)});
+  }
+  return best;
+}
+
+// The highest z of the surface over the horizontal R-neighbourhood of a segment, bounded
+// from above by branch and bound: a sub-patch lies in the convex hull of its control
+// points, so under its box's top, and outside the neighbourhood if its box's footprint is.
+// Corner points of the sub-patches in the neighbourhood are surface points: their highest z
+// is a lower bound, and the search stops once the best box is within `tolerance` of it.
+class HeightBound {
+ public:
+  HeightBound(const Surface& surface, double tolerance, double slack)
+      : surface_(surface), tolerance_(tolerance), slack_(slack) {}
+
+  // >= z of every surface point at horizontal distance < radius from [a, b]; -inf if
+  // there is none.
+  double above(Vec2 a, Vec2 b, double radius) const {
+    struct Cell {
+      BezierPatch patch;
+      Box box;
+      int depth;
+    };
+    const auto lower = [](const Cell& p, const Cell& q) { return p.box.z1 < q.box.z1; };
+    std::priority_queue<Cell, std::vector<Cell>, decltype(lower)> queue(lower);
+    // Rounding could put a box a hair too far: keep boxes up to `slack_` beyond the reach,
+    // which only loosens the bound.
+    const double reach = radius + slack_;
+    double known = -kInf;  // the highest surface point seen in the neighbourhood
+    const auto push = [&](BezierPatch&& patch, int depth) {
+      const Box box = controlBox(patch);
+      if (!(segmentBoxDistance(a, b, box) < reach)) return;
+      const int m = patch.degreeU, n = patch.degreeV;
+      for (const Vec3& c : {patch.at(0, 0), patch.at(0, n), patch.at(m, 0), patch.at(m, n),
+                            point(patch, 0.5, 0.5)})
+        if (pointSegmentDistance({c.x, c.y}, a, b) <= reach) known = std::max(known, c.z);
+      queue.push({std::move(patch), box, depth});
+    };
+    for (const BezierPatch& patch : surface_.patches) push(BezierPatch(patch), 0);
+    std::size_t cells = 0;
+    while (!queue.empty()) {
+      const Cell top = queue.top();
+      queue.pop();
+      // Every cell left lies under top.box.z1: it bounds the whole neighbourhood.
+      if (top.box.z1 <= known + tolerance_ || ++cells > kLinkMaxCells || top.depth >= 40)
+        return top.box.z1 + slack_;
+      auto [left, right] = subdivideU(top.patch, 0.5);
+      for (BezierPatch* half : {&left, &right}) {
+        auto [low, high] = subdivideV(*half, 0.5);
+        push(std::move(low), top.depth + 1);
+        push(std::move(high), top.depth + 1);
+      }
+    }
+    return -kInf;
+  }
+
+ private:
+  const Surface& surface_;
+  double tolerance_;
+  double slack_;
+};
+
+// ---------------------------------------------------------------------------------------
+// The best feed angle
+// ---------------------------------------------------------------------------------------
+
+// alpha(a) = acos(max |e(a) . n|) over the surface, two ways: `estimate` from normals
+// sampled once on a grid (a few flops per sample and angle: the scan), `refined` with the
+// largest grid samples of each patch climbed to their local maxima by a shrinking pattern
+// search (the golden-section stage, where the grid's error would otherwise decide).
+class AngleObjective {
+ public:
+  explicit AngleObjective(const Surface& surface) : surface_(surface) {
+    for (std::size_t p = 0; p < surface.patches.size(); ++p) {
+      first_.push_back(samples_.size());
+      for (int i = 0; i <= kAngleGrid; ++i)
+        for (int j = 0; j <= kAngleGrid; ++j) {
+          const double u = double(i) / kAngleGrid, v = double(j) / kAngleGrid;
+          const Vec3 n = unitNormal(surface.patches[p], u, v);
+          samples_.push_back({n.x, n.y, u, v});
+        }
+    }
+    first_.push_back(samples_.size());
+  }
+
+  static Vec2 normalOf(double a) { return {-std::sin(a), std::cos(a)}; }
+
+  double estimate(double a) const {
+    const Vec2 e = normalOf(a);
+    double largest = 0.0;
+    for (const Sample& s : samples_) largest = std::max(largest, std::abs(e.x * s.nx + e.y * s.ny));
+    return std::acos(std::min(1.0, largest));
+  }
+
+  double refined(double a) const {
+    constexpr std::size_t kSeeds = 4;
+    const Vec2 e2 = normalOf(a);
+    const Vec3 e{e2.x, e2.y, 0.0};
+    double largest = 0.0;
+    for (std::size_t p = 0; p + 1 < first_.size(); ++p) {
+      const BezierPatch& patch = surface_.patches[p];
+      struct Seed {
+        double value, u, v;
+      };
+      std::vector<Seed> seeds;
+      for (std::size_t i = first_[p]; i < first_[p + 1]; ++i) {
+        const Sample& s = samples_[i];
+        seeds.push_back({std::abs(e.x * s.nx + e.y * s.ny), s.u, s.v});
+      }
+      const std::size_t count = std::min(kSeeds, seeds.size());
+      std::partial_sort(seeds.begin(), seeds.begin() + static_cast<std::ptrdiff_t>(count),
+                        seeds.end(), [](const Seed& x, const Seed& y) { return x.value > y.value; });
+      for (std::size_t k = 0; k < count; ++k) {
+        Seed c = seeds[k];
+        for (double step = 1.0 / kAngleGrid; step > 1e-10; step *= 0.5) {
+          for (bool moved = true; moved;) {
+            moved = false;
+            for (const auto& [du, dv] : {std::pair{1, 0}, std::pair{-1, 0}, std::pair{0, 1},
+                                         std::pair{0, -1}, std::pair{1, 1}, std::pair{-1, -1},
+                                         std::pair{1, -1}, std::pair{-1, 1}}) {
+              const double u = std::clamp(c.u + du * step, 0.0, 1.0);
+              const double v = std::clamp(c.v + dv * step, 0.0, 1.0);
+              const double g = std::abs(dot(unitNormal(patch, u, v), e));
+              if (g > c.value) c = {g, u, v}, moved = true;
+            }
+          }
+        }
+        largest = std::max(largest, c.value);
+      }
+    }
+    return std::acos(std::min(1.0, largest));
+  }
+
+ private:
+  struct Sample {
+    double nx, ny, u, v;
+  };
+  const Surface& surface_;
+  std::vector<Sample> samples_;
+  std::vector<std::size_t> first_;  // patch p's samples: [first_[p], first_[p + 1])
+};
+
+// The maximiser of f on [lo, hi] by golden-section search: robust for a unimodal f with
+// kinks (alpha is a minimum over the surface, so its maxima are often where two normals
+// tie), where derivative-based steps would stall.
+template <class F>
+std::pair<double, double> goldenMaximum(const F& f, double lo, double hi, double tolerance) {
+  const double ratio = (std::sqrt(5.0) - 1.0) / 2.0;
+  double x1 = hi - ratio * (hi - lo), x2 = lo + ratio * (hi - lo);
+  double f1 = f(x1), f2 = f(x2);
+  while (hi - lo > tolerance) {
+    if (f1 >= f2) {
+      hi = x2, x2 = x1, f2 = f1;
+      x1 = hi - ratio * (hi - lo), f1 = f(x1);
+    } else {
+      lo = x1, x1 = x2, f1 = f2;
+      x2 = lo + ratio * (hi - lo), f2 = f(x2);
+    }
+  }
+  return f1 >= f2 ? std::pair{x1, f1} : std::pair{x2, f2};
+}
+
+}  // namespace
+
+double bestRasterAngle(const Surface& surface) {
+  validateSurface(surface);
+  const AngleObjective objective(surface);
+  // alpha is pi-periodic in a (e and -e make the same planes): scan [0, pi) and keep the
+  // best few local maxima of the estimate, cyclically.
+  std::vector<double> scan(kAngleScan);
+  const double step = kPi / kAngleScan;
+  for (int i = 0; i < kAngleScan; ++i)
+    scan[static_cast<std::size_t>(i)] = objective.estimate(i * step);
+  std::vector<std::pair<double, int>> peaks;
+  for (int i = 0; i < kAngleScan; ++i) {
+    const double here = scan[static_cast<std::size_t>(i)];
+    const double before = scan[static_cast<std::size_t>((i + kAngleScan - 1) % kAngleScan)];
+    const double after = scan[static_cast<std::size_t>((i + 1) % kAngleScan)];
+    if (here >= before && here >= after) peaks.push_back({here, i});
+  }
+  std::sort(peaks.begin(), peaks.end(), std::greater<>());
+  constexpr std::size_t kCandidates = 3;
+  double bestAngle = 0.0;
+  double bestAlpha = -1.0;
+  for (std::size_t c = 0; c < std::min(kCandidates, peaks.size()); ++c) {
+    const double centre = peaks[c].second * step;
+    const auto [a, alpha] = goldenMaximum([&](double x) { return objective.refined(x); },
+                                          centre - step, centre + step, 1e-9);
+    if (alpha > bestAlpha) bestAlpha = alpha, bestAngle = a;
+  }
+  bestAngle = std::fmod(bestAngle, kPi);
+  if (bestAngle < 0.0) bestAngle += kPi;
+  return bestAngle >= kPi ? 0.0 : bestAngle;
+}
+
+RasterPaths rasterPaths(const Surface& surface, const RasterOptions& options) {
+  validateSurface(surface);
+  requirePositive("the tool radius", options.toolRadius);
+  if (!options.bestAngle && !std::isfinite(options.angleRad))
+    throw Error(fmt::format("the feed angle must be a finite number of radians, got {}",
+                            options.angleRad));
+  if (options.scallopHeight != 0.0) {
+    if (options.spacing != 0.0)
+      throw Error(fmt::format("give the step-over ({}) or the scallop height ({}), not both",
+                              options.spacing, options.scallopHeight));
+    requirePositive("the scallop height", options.scallopHeight);
+  } else {
+    requirePositive("the step-over (plane spacing)", options.spacing);
+  }
+  requireNonNegative("the chordal tolerance", options.chordalTolerance);
+  requireNonNegative("the arc tolerance", options.arcTolerance);
+  const double scale = std::max(surfaceScale(surface), 1e-300);
+  const double tolerance =
+      options.chordalTolerance > 0.0 ? options.chordalTolerance : 1e-4 * scale;
+  requirePositive("the chordal tolerance", tolerance);  // 1e-4 scale may underflow
+  const double arcTolerance = options.arcTolerance > 0.0 ? options.arcTolerance : tolerance;
+  const double radius = options.toolRadius;
+  const double tau = kRasterTurnTolerance * scale;
+
+  RasterPaths out;
+  out.angleRad = options.bestAngle ? bestRasterAngle(surface) : options.angleRad;
+  const Frame frame = frameFor(out.angleRad);
+  out.feedDirection = frame.d;
+  out.planeNormal = frame.e;
+  out.alphaRad = minimumAngleBound(surface, frame.e);
+  out.spacing = options.spacing > 0.0
+                    ? options.spacing
+                    : spacingForScallopHeight(radius, options.scallopHeight, out.alphaRad);
+  out.path.units = surface.units;
+  out.path.toolRadius = radius;
+
+  // As contour.cpp: e . r over the control points bounds e . r over the surface.
+  double lo = kInf, hi = -kInf;
+  for (const BezierPatch& patch : surface.patches)
+    for (const Vec3& p : patch.control) {
+      lo = std::min(lo, dot(frame.e, p));
+      hi = std::max(hi, dot(frame.e, p));
+    }
+  const double first = std::ceil(lo / out.spacing);
+  const double last = std::floor(hi / out.spacing);
+  if (last - first > 1e7)
+    throw Error(fmt::format("the step-over {} gives {:.0f} planes across the surface; "
+                            "more than 10 million is not a tool path",
+                            out.spacing, last - first + 1));
+
+  const HeightBound heights(surface, tolerance, 1e-12 * scale);
+  for (double kk = first; kk <= last; kk += 1.0) {
+    const double w = kk * out.spacing;
+    PlaneSection section = planeSection(surface, frame.e, w, tolerance);
+    out.stats.touchPoints += section.touchPoints.size();
+    RasterSection plane;
+    plane.offset = w;
+    plane.k = static_cast<long long>(kk);
+    plane.chains = planeChains(section, frame, w, radius, tau);
+    if (plane.chains.empty()) continue;
+    plane.reversed = out.sections.size() % 2 == 1;
+    ++out.stats.planes;
+    out.stats.components += section.components;
+    for (const SectionCurve& curve : section.curves) out.stats.contactLength += curveLength(curve);
+
+    const std::size_t index = out.sections.size();
+    const std::size_t n = plane.chains.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t c = plane.reversed ? n - 1 - i : i;
+      RasterChain& chain = plane.chains[c];
+      chain.hull = scallopHull(chain.chain, radius);
+      out.stats.centreLength += pathLength(chain.hull.toolpath);
+      ToolPass pass = passFromHull(chain.hull, frame, w, arcTolerance);
+      if (plane.reversed) pass = reversedPass(pass);
+      RasterPass info{index, c, plane.reversed, 0, 0.0};
+      // The first pass of a plane after the first is linked from the previous pass's end
+      // (which lies at the same end of the surface: zigzag); the rest are retracted.
+      if (i == 0 && !out.path.passes.empty()) {
+        const Vec3 from = passEnd(out.path.passes.back());
+        const Vec3 to = pass.start;
+        const double surfaceTop = heights.above({from.x, from.y}, {to.x, to.y}, radius);
+        const double height = std::max({from.z, to.z, surfaceTop + radius});
+        std::vector<ToolMove> link;
+        const auto line = [](Vec3 end) { return ToolMove{MoveKind::line, end, {}, ArcPlane::xy, true}; };
+        Vec3 at = from;
+        for (const Vec3 next : {Vec3{from.x, from.y, height}, Vec3{to.x, to.y, height}, to}) {
+          if (next == at) continue;
+          out.linkLength += norm(next - at);
+          link.push_back(line(next));
+          at = next;
+        }
+        info.linkMoves = link.size();
+        info.linkHeight = height;
+        pass.moves.insert(pass.moves.begin(), link.begin(), link.end());
+        pass.start = from;
+        pass.retractBefore = false;
+      } else {
+        pass.retractBefore = true;
+      }
+      chain.pass = out.path.passes.size();
+      out.path.passes.push_back(std::move(pass));
+      out.passes.push_back(info);
+    }
+    plane.section = std::move(section);
+    out.sections.push_back(std::move(plane));
+  }
+  if (out.sections.empty())
+    throw Error(fmt::format(
+        "no plane e . r = k * {} with e = ({}, {}, 0) cuts the surface (e . r spans [{}, {}])",
+        out.spacing, frame.e.x, frame.e.y, lo, hi));
+  return out;
+}
+
+}  // namespace scallop

@@ -1,0 +1,168 @@
+// End-to-end tests of `scallop paths` and `scallop plan`: the main job writes its folder,
+// the JSON agrees with itself and with the G-code, and bad input fails cleanly (one error
+// line naming the problem, exit status 1, nothing written).
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_fixture.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using scallop::test::CliFixture;
+using scallop::test::readFile;
+using scallop::test::RunResult;
+
+class PathsCli : public CliFixture {};
+
+// A wall folding back over itself along x: not a graph z = f(x, y) over the raster direction.
+constexpr const char* kFoldedSurface = R"({"units": "mm", "patches": [{"degree": [3, 1],
+  "control_points": [[[0, 0, 0], [0, 10, 0]], [[20, 0, 5], [20, 10, 5]],
+                     [[-10, 0, 10], [-10, 10, 10]], [[10, 0, 15], [10, 10, 15]]]}]})";
+
+// No exponent, no nan or inf anywhere in a G-code program: outside comments only words of
+// the letters scallop writes, digits, '.', '-', blanks and '%'.
+void expectPlainNumbers(const std::string& gcode) {
+  const std::string allowed = "GMSFXYZIJKPT0123456789.- \n%";
+  for (std::size_t i = 0; i < gcode.size(); ++i) {
+    if (gcode[i] == '(') {  // comments may say anything
+      i = gcode.find(')', i);
+      ASSERT_NE(i, std::string::npos);
+      continue;
+    }
+    ASSERT_NE(allowed.find(gcode[i]), std::string::npos)
+        << "unexpected '" << gcode[i] << "': " << gcode.substr(i > 20 ? i - 20 : 0, 40);
+  }
+}
+
+TEST_F(PathsCli, PlanWithNoArgumentsWritesTheWholeFolder) {
+  const RunResult result = run("plan");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  EXPECT_TRUE(result.out.empty());
+  EXPECT_NE(result.err.find("alpha* = 78.04"), std::string::npos) << result.err;
+  std::vector<std::string> files;
+  for (const auto& entry : fs::directory_iterator(workDir_ / "scallop-out"))
+    files.push_back(entry.path().filename().string());
+  std::sort(files.begin(), files.end());
+  EXPECT_EQ(files, (std::vector<std::string>{"gauss-map.svg", "paths-plan.svg", "paths.svg",
+                                             "report.json", "stereographic.svg", "toolpath.ngc"}));
+  const auto report = nlohmann::json::parse(readFile(workDir_ / "scallop-out" / "report.json"));
+  EXPECT_EQ(report["strategy"], "contour");
+  EXPECT_EQ(report["units"], "in");
+  EXPECT_EQ(report["tool_radius"], 0.25);
+  EXPECT_TRUE(report["orientation"]["certified"].get<bool>());
+  // The planes' normal is N* up to sign, and the spacing follows from H = 0.001 and alpha.
+  const auto& n = report["plane_normal"];
+  const auto& m = report["orientation"]["normal"];
+  const double dotNm = n[0].get<double>() * m[0].get<double>() + n[1].get<double>() * m[1].get<double>() +
+                       n[2].get<double>() * m[2].get<double>();
+  EXPECT_NEAR(std::abs(dotNm), 1.0, 1e-12);
+  const double alpha = report["alpha_deg"].get<double>() * M_PI / 180.0;
+  EXPECT_NEAR(report["spacing"].get<double>(), 2 * std::sqrt(2 * 0.25 * 0.001 - 1e-6) * std::sin(alpha), 1e-12);
+  const auto& stats = report["stats"];
+  EXPECT_GT(stats["planes"].get<int>(), 50);
+  EXPECT_EQ(stats["passes"].get<std::size_t>(), report["passes"].size());
+  // The centre length is the sum of the passes' line lengths.
+  double length = 0.0;
+  for (const auto& pass : report["passes"]) {
+    std::vector<double> at = pass["start"].get<std::vector<double>>();
+    for (const auto& move : pass["moves"]) {
+      const std::vector<double> end = move["line"].get<std::vector<double>>();
+      length += std::hypot(end[0] - at[0], end[1] - at[1], end[2] - at[2]);
+      at = end;
+    }
+  }
+  EXPECT_NEAR(length, stats["centre_length"].get<double>(), 1e-9 * length);
+  const std::string gcode = readFile(workDir_ / "scallop-out" / "toolpath.ngc");
+  EXPECT_NE(gcode.find("G20"), std::string::npos);
+  EXPECT_NE(gcode.find("M2"), std::string::npos);
+  expectPlainNumbers(gcode);
+}
+
+TEST_F(PathsCli, PlanRasterReportsTheGougeCheck) {
+  const RunResult result = run("plan --strategy raster --out r --quiet --dialect grbl");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const auto report = nlohmann::json::parse(readFile(workDir_ / "r" / "report.json"));
+  EXPECT_EQ(report["strategy"], "raster");
+  ASSERT_TRUE(report["gouge"].is_object());
+  EXPECT_GE(report["gouge"]["max_depth"].get<double>(), 0.0);
+  EXPECT_GE(report["gouge"]["depth_bound"].get<double>(), report["gouge"]["max_depth"].get<double>());
+  EXPECT_TRUE(fs::exists(workDir_ / "r" / "toolpath.gcode"));
+  expectPlainNumbers(readFile(workDir_ / "r" / "toolpath.gcode"));
+}
+
+TEST_F(PathsCli, PathsWritesJsonToStandardOutputByDefault) {
+  const RunResult result = run("paths --example paper-2 --tool-radius 0.25 --spacing 0.0267 "
+                               "--normal 0.975,-0.221,-0.002");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const auto report = nlohmann::json::parse(result.out);
+  // Table 1 of the paper, last row: 359.23 in and 134 components.
+  EXPECT_NEAR(report["stats"]["centre_length"].get<double>(), 359.23, 0.01 * 359.23);
+  EXPECT_EQ(report["stats"]["components"].get<int>(), 134);
+  EXPECT_TRUE(listing().empty());
+}
+
+TEST_F(PathsCli, PathsRasterAlongXWritesArcsInTheZxPlane) {
+  const RunResult result = run("paths --example paper-1 --tool-radius 0.25 --spacing 0.1 "
+                               "--strategy raster --angle 0 --gcode p.ngc --svg p.svg --json p.json");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const std::string gcode = readFile(workDir_ / "p.ngc");
+  EXPECT_NE(gcode.find("G18"), std::string::npos);
+  expectPlainNumbers(gcode);
+  EXPECT_EQ(readFile(workDir_ / "p.svg").rfind("<svg", 0), 0u);
+}
+
+TEST_F(PathsCli, BadInputFailsWithMessageAndWritesNothing) {
+  struct Bad {
+    const char* arguments;
+    std::vector<std::string> parts;
+  };
+  const Bad bads[] = {
+      {"--example paper-1 --tool-radius 0 --spacing 0.1", {"tool radius", "'0'", "positive"}},
+      {"--example paper-1 --tool-radius -1 --spacing 0.1", {"tool radius", "'-1'"}},
+      {"--example paper-1 --tool-radius nan --spacing 0.1", {"tool radius", "'nan'"}},
+      {"--example paper-1 --tool-radius 0.25 --spacing 0", {"spacing", "'0'"}},
+      {"--example paper-1 --tool-radius 0.25 --spacing -0.5", {"spacing", "'-0.5'"}},
+      {"--example paper-1 --tool-radius 0.25 --spacing 0.1 --normal 0,0,0", {"normal", "zero"}},
+      {"--example paper-1 --tool-radius 0.25 --spacing 0.1 --normal nan,0,1", {"normal", "'nan'"}},
+      {"--example paper-1 --tool-radius 0.25 --spacing 0.1 --normal 1,2", {"normal", "X,Y,Z"}},
+      {"--example paper-1 --tool-radius 0.25 --scallop-height 0.25", {"scallop height", "smaller"}},
+      {"--example paper-1 --tool-radius 0.25 --scallop-height 0.3", {"scallop height", "0.3"}},
+      {"--example paper-1 --tool-radius 0.25 --spacing 100 --normal 0,0,1", {"cuts the surface"}},
+      {"--example paper-1 --tool-radius 0.25 --scallop-height 0.001 --normal 0,0,1",
+       {"tangency", "spacing"}},
+      {"folded.json --tool-radius 1 --spacing 1 --strategy raster --angle 0", {"folded.json", "graph"}},
+  };
+  for (const Bad& bad : bads) {
+    SCOPED_TRACE(bad.arguments);
+    fs::remove_all(workDir_);
+    fs::create_directory(workDir_);
+    write("folded.json", kFoldedSurface);
+    const RunResult result =
+        run(std::string("paths ") + bad.arguments + " --json out.json --gcode out.ngc --svg out.svg");
+    expectCleanFailure(result, bad.parts, "folded.json");
+  }
+}
+
+TEST_F(PathsCli, PlanFailsCleanlyAndLeavesNoFolder) {
+  write("folded.json", kFoldedSurface);
+  expectCleanFailure(run("plan --quiet --tool-radius 0"), {"tool radius"}, "folded.json");
+  expectCleanFailure(run("plan --quiet --scallop-height 1"), {"scallop height"}, "folded.json");
+  expectCleanFailure(run("plan folded.json --quiet --strategy raster --tool-radius 1"), {"graph"},
+                     "folded.json");
+  // The folder cannot be made (a file is in the way): nothing is left.
+  write("blocked", "x");
+  const RunResult result = run("plan --quiet --out blocked/out");
+  EXPECT_EQ(result.exitCode, 1);
+  EXPECT_EQ(listing(), (std::vector<std::string>{"blocked", "folded.json"}));
+}
+
+}  // namespace
