@@ -44,6 +44,7 @@
 #include <unistd.h>
 #include <vector>
 
+#include "rs274.hpp"
 #include "scallop/error.hpp"
 #include "scallop/gcode.hpp"
 #include "scallop/toolpath.hpp"
@@ -129,7 +130,9 @@ double safeHeightFor(const ToolPath& path, double margin) {
     Vec3 current = pass.start;
     for (const ToolMove& move : pass.moves) {
       top = std::max(top, move.end.z);
-      if (move.kind == MoveKind::arc) top = std::max(top, move.center.z + norm(current - move.center));
+      if (move.kind == MoveKind::arc) {
+        top = std::max(top, move.center.z + norm(current - move.center));
+      }
       current = move.end;
     }
   }
@@ -240,8 +243,9 @@ ToolPath randomPath(std::uint64_t seed, int passes, int movesPerPass) {
         const double radius = uniform(0.02, 1.5);
         const Vec3 direction = rotate(cross(n, Vec3{0.6, 0.7, 0.8}), n, uniform(0.0, 2.0 * kPi));
         const Vec3 centre = position + (radius / norm(direction)) * direction;
-        const ToolMove arc =
-            arcFrom(position, centre, plane, unit(rng) < 0.5, uniform(0.02, 2.0 * kPi - 0.02));
+        const bool clockwise = unit(rng) < 0.5;  // one draw per statement: a fixed order
+        const double sweep = uniform(0.02, 2.0 * kPi - 0.02);
+        const ToolMove arc = arcFrom(position, centre, plane, clockwise, sweep);
         pass.moves.push_back(arc);
         position = arc.end;
       }
@@ -255,60 +259,9 @@ ToolPath randomPath(std::uint64_t seed, int passes, int movesPerPass) {
 // Running LinuxCNC's interpreter
 // ---------------------------------------------------------------------------------------
 
-std::string readFile(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
-// rs274: where CMake found it, else on PATH; empty when it is not installed.
-std::string findRs274() {
-  namespace fs = std::filesystem;
-  const std::string configured = SCALLOP_RS274_PATH;
-  if (!configured.empty() && ::access(configured.c_str(), X_OK) == 0) return configured;
-  const char* pathVariable = std::getenv("PATH");
-  std::stringstream directories(pathVariable ? pathVariable : "");
-  std::string directory;
-  while (std::getline(directories, directory, ':')) {
-    if (directory.empty()) continue;
-    const fs::path candidate = fs::path(directory) / "rs274";
-    if (::access(candidate.c_str(), X_OK) == 0) return candidate.string();
-  }
-  return "";
-}
-
-struct Rs274Run {
-  int exitCode = -1;
-  std::string out;
-  std::string err;
-};
-
-// Runs `rs274 -g` on `program` in a fresh temporary directory, removed afterwards, which
-// holds everything the interpreter touches: it is the working directory and HOME (rs274
-// creates, truncates and maps $HOME/.tool.mmap, so parallel runs sharing a HOME crash each
-// other with SIGBUS), and holds an empty tool table (-t; by default rs274 reads a sample
-// one from /usr/share/doc) and the parameter file (-v; by default it tries to write one
-// under /etc/emc2).
-Rs274Run runRs274(const std::string& rs274, const std::string& program) {
-  namespace fs = std::filesystem;
-  std::string pattern = (fs::temp_directory_path() / "scallop-gcode-XXXXXX").string();
-  if (::mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
-  const fs::path dir = pattern;
-  std::ofstream(dir / "program.ngc", std::ios::binary) << program;
-  std::ofstream(dir / "tools.tbl", std::ios::binary) << "";
-  // Empty, but present: rs274 links the old file to a backup and complains if it is missing.
-  std::ofstream(dir / "params.var", std::ios::binary) << "";
-  const std::string command = "cd '" + dir.string() + "' && HOME='" + dir.string() + "' '" +
-                              rs274 +
-                              "' -t tools.tbl -v params.var -g program.ngc > canon.txt "
-                              "2> err.txt < /dev/null";
-  const int status = std::system(command.c_str());
-  Rs274Run run;
-  run.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  run.out = readFile(dir / "canon.txt");
-  run.err = readFile(dir / "err.txt");
-  fs::remove_all(dir);
-  return run;
-}
+using scallop::test::findRs274;
+using scallop::test::Rs274Run;
+using scallop::test::runRs274;
 
 struct CanonCall {
   std::string name;
@@ -489,6 +442,10 @@ std::vector<Motion> expectedCuts(const ToolPath& path, const GcodeOptions& optio
         m.centre = tipOf(move.center, r);
         m.axis = (move.clockwise ? -1.0 : 1.0) * planeNormal(move.plane);
         m.sweep = sweepAbout(m.start - m.centre, m.end - m.centre, m.axis);
+        // As documented: an arc of at most a half turn whose sagitta is within half a
+        // quantum of its chord is written as a line.
+        const double sagitta = norm(m.start - m.centre) * (1.0 - std::cos(0.5 * m.sweep));
+        if (m.sweep <= kPi && sagitta <= 0.5 * quantum(path.units)) m.kind = Motion::Kind::feed;
       }
       cuts.push_back(m);
       current = m.end;
@@ -860,15 +817,16 @@ TEST(GcodeValidation, BadOptionsNameTheOptionAndValue) {
 }
 
 TEST(GcodeValidation, SafeHeightMustClearTheTopOfVerticalArcs) {
-  // A half turn in G18 from x = 0 over the top to x = 2: the ends are at z = 0, the top at
-  // z = 1 (tips: radius 0.1 lower).
+  // A half turn in G18 (G19) from x (y) = 0 to 2 about x (y) = 1, z = 0: the ends are at
+  // z = 0, the middle at z = +1 or -1 depending on the direction (tips: 0.1 lower). Which
+  // one is computed here by Rodrigues' formula, not assumed.
   for (const ArcPlane plane : {ArcPlane::zx, ArcPlane::yz}) {
     ToolPath path;
     path.toolRadius = 0.1;
     ToolPass pass;
     pass.start = {0, 0, 0};
     const Vec3 centre = plane == ArcPlane::zx ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
-    // Over the top: clockwise seen from +y for G18 (x to z to -x... ), found by trying both.
+    int overTheTop = 0;
     for (const bool clockwise : {true, false}) {
       pass.moves = {arcFrom(pass.start, centre, plane, clockwise, kPi)};
       path.passes = {pass};
@@ -878,11 +836,13 @@ TEST(GcodeValidation, SafeHeightMustClearTheTopOfVerticalArcs) {
       GcodeOptions options = optionsFor(path, GcodeDialect::linuxcnc);
       options.safeHeight = 0.5;  // above both ends' tips (-0.1), below the top's if it is up
       if (middle.z > 0.5) {
+        ++overTheTop;
         expectError(path, options, {"safeHeight", "0.5", "pass 0, move 0 (top of the arc)"});
       } else {
         EXPECT_NO_THROW((void)gcodeProgram(path, options));
       }
     }
+    EXPECT_EQ(overTheTop, 1);
   }
 }
 
@@ -965,11 +925,14 @@ TEST(GcodeArcPolyline, CircumscribesRandomArcsWithinTolerance) {
   for (int trial = 0; trial < 5000; ++trial) {
     const double radius = std::pow(10.0, -3.0 + 6.0 * unit(rng));
     const double tolerance = radius * std::pow(10.0, -6.0 + 6.5 * unit(rng));
-    const double sweep = trial % 50 == 0 ? 2.0 * kPi : 2.0 * kPi * (1e-4 + (1.0 - 1e-4) * unit(rng));
+    const double sweep =
+        trial % 50 == 0 ? 2.0 * kPi : 2.0 * kPi * (1e-4 + (1.0 - 1e-4) * unit(rng));
     const Vec3 axis = randomDirection(rng);
     Vec3 u = cross(axis, randomDirection(rng));
     u = normalized(u);
-    const Vec3 centre = Vec3{unit(rng), unit(rng), unit(rng)} * (100.0 * unit(rng) - 50.0);
+    // (One draw per statement: the order of operands is unspecified, the test's is fixed.)
+    const Vec3 direction = {unit(rng), unit(rng), unit(rng)};
+    const Vec3 centre = direction * (100.0 * unit(rng) - 50.0);
     const Vec3 start = centre + radius * u;
     const Vec3 end = sweep == 2.0 * kPi ? start : centre + rotate(radius * u, axis, sweep);
     const std::vector<Vec3> poly = arcPolyline(start, end, centre, axis, tolerance);

@@ -7,12 +7,14 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "cli_fixture.hpp"
+#include "rs274.hpp"
 
 namespace {
 
@@ -97,6 +99,43 @@ TEST_F(PathsCli, PlanRasterReportsTheGougeCheck) {
   EXPECT_GE(report["gouge"]["depth_bound"].get<double>(), report["gouge"]["max_depth"].get<double>());
   EXPECT_TRUE(fs::exists(workDir_ / "r" / "toolpath.gcode"));
   expectPlainNumbers(readFile(workDir_ / "r" / "toolpath.gcode"));
+}
+
+// The main job's G-code, for both strategies and both dialects, goes through LinuxCNC's own
+// interpreter without a single complaint, and its cutting moves end where the report's passes
+// say (tips = centres - R).
+TEST_F(PathsCli, PlanGcodeIsAcceptedByLinuxCnc) {
+  const std::string rs274 = scallop::test::findRs274();
+  ASSERT_FALSE(rs274.empty()) << "LinuxCNC's rs274 was not found: install linuxcnc-uspace "
+                                 "(tools/setup.sh test does)";
+  for (const char* arguments : {"plan --quiet --out c", "plan --quiet --strategy raster --out r",
+                                "plan --quiet --example paper-2 --dialect grbl --out g"}) {
+    SCOPED_TRACE(arguments);
+    const RunResult result = run(arguments);
+    ASSERT_EQ(result.exitCode, 0) << result.err;
+    const std::string dir = std::string(arguments).substr(std::string(arguments).rfind(' ') + 1);
+    const bool grbl = dir == "g";
+    const std::string gcode = readFile(workDir_ / dir / (grbl ? "toolpath.gcode" : "toolpath.ngc"));
+    const scallop::test::Rs274Run interpreted = scallop::test::runRs274(rs274, gcode);
+    EXPECT_EQ(interpreted.exitCode, 0) << interpreted.err;
+    std::stringstream err(interpreted.err);
+    for (std::string line; std::getline(err, line);)
+      EXPECT_TRUE(line.empty() || line == "executing") << "rs274 reported: " << line;
+    // Count the feed moves (STRAIGHT_FEED and ARC_FEED) against the report's moves plus one
+    // plunge per retracted pass.
+    std::size_t feeds = 0;
+    std::stringstream canon(interpreted.out);
+    for (std::string line; std::getline(canon, line);)
+      if (line.find("STRAIGHT_FEED(") != std::string::npos || line.find("ARC_FEED(") != std::string::npos)
+        ++feeds;
+    const auto report = nlohmann::json::parse(readFile(workDir_ / dir / "report.json"));
+    std::size_t moves = 0;
+    for (const auto& pass : report["passes"])
+      moves += pass["moves"].size() + (pass["retract_before"].get<bool>() ? 1 : 0);
+    // The writer may drop moves shorter than its printed precision; never adds any.
+    EXPECT_LE(feeds, moves);
+    EXPECT_GE(feeds, moves * 99 / 100);
+  }
 }
 
 TEST_F(PathsCli, PathsWritesJsonToStandardOutputByDefault) {

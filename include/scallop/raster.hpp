@@ -57,10 +57,12 @@
 //         on sub-patches (each within the convex hull of its control points, so under its
 //         box's top) until it is within the chordal tolerance of a surface point in the
 //         region (or after kLinkMaxCells cells, still a bound). The vertical moves are safe
-//         in their planes (the ball is R beyond the chain's end, above its last vertex);
-//         like the passes, out of plane they are gougeCheck's business (gouge.hpp). Further
-//         chains of one plane are entered from the safe height (retractBefore = true), as
-//         is the first pass.
+//         in their planes (the ball is R beyond the chain's end, above its last vertex), but
+//         not beside them: where the surface's boundary is oblique to the feed, the pass's
+//         end lies over neighbouring parts of the surface, and rising from it the ball can
+//         cut into any that stand higher than the end (as a retraction from there would);
+//         gougeCheck (gouge.hpp) measures it with the passes. Further chains of one plane
+//         are entered from the safe height (retractBefore = true), as is the first pass.
 // Gouging: the offset in the section plane rules out gouging within that plane only; the
 //         ball may still cut into the surface beside the plane where the surface rises
 //         across it. gouge.hpp measures the deepest interference along this path.

@@ -1,0 +1,100 @@
+// scallop-bench, tool paths: the main job (`scallop plan`) on each example surface for both
+// strategies, and plane sections per second.
+//   BM_PlanContour/<surface>  N* (optimalSlicing) -> contour paths at 0.001 in scallops ->
+//                             G-code: what `scallop plan` computes, without the figures
+//   BM_PlanRaster/<surface>   best feed angle -> raster paths (scallop hull per section) ->
+//                             gouge check every R / 10 -> G-code
+//   BM_PlaneSection/<surface> one section by a plane z = c, c cycling through 64 levels over
+//                             the surface's height: sections per second
+
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include "scallop/contour.hpp"
+#include "scallop/gcode.hpp"
+#include "scallop/gouge.hpp"
+#include "scallop/optimal_slicing.hpp"
+#include "scallop/raster.hpp"
+#include "scallop/section.hpp"
+#include "scallop/surface.hpp"
+
+namespace {
+
+constexpr double kToolRadius = 0.25;       // inches, as the paper's Table 1
+constexpr double kScallopHeight = 0.001;   // inches, scallop plan's default
+
+const char* surfaceName(const benchmark::State& state) {
+  return state.range(0) == 1 ? "paper-1" : "paper-2";
+}
+
+scallop::GcodeOptions gcodeOptions() {
+  scallop::GcodeOptions options;
+  options.safeHeight = 3.0;
+  options.feedRate = 40.0;
+  options.plungeFeedRate = 15.0;
+  options.spindleRpm = 10000.0;
+  return options;
+}
+
+void BM_PlanContour(benchmark::State& state) {
+  const scallop::Surface surface = scallop::exampleSurface(surfaceName(state));
+  std::size_t passes = 0;
+  for (auto _ : state) {
+    const scallop::OptimalSlicing orientation = scallop::optimalSlicing(surface);
+    scallop::ContourOptions options;
+    options.normal = orientation.normal;
+    options.toolRadius = kToolRadius;
+    options.spacing = scallop::spacingForScallopHeight(kToolRadius, kScallopHeight,
+                                                       orientation.certifiedAlphaRad);
+    const scallop::ContourPaths paths = scallop::contourPaths(surface, options);
+    const std::string gcode = scallop::gcodeProgram(paths.path, gcodeOptions());
+    benchmark::DoNotOptimize(gcode.data());
+    passes = paths.path.passes.size();
+  }
+  state.counters["passes"] = static_cast<double>(passes);
+  state.SetLabel(surfaceName(state));
+}
+
+void BM_PlanRaster(benchmark::State& state) {
+  const scallop::Surface surface = scallop::exampleSurface(surfaceName(state));
+  std::size_t passes = 0;
+  double depth = 0.0;
+  for (auto _ : state) {
+    scallop::RasterOptions options;
+    options.bestAngle = true;
+    options.toolRadius = kToolRadius;
+    options.scallopHeight = kScallopHeight;
+    const scallop::RasterPaths paths = scallop::rasterPaths(surface, options);
+    const scallop::GougeReport gouge = scallop::gougeCheck(surface, paths.path, kToolRadius / 10.0);
+    const std::string gcode = scallop::gcodeProgram(paths.path, gcodeOptions());
+    benchmark::DoNotOptimize(gcode.data());
+    passes = paths.path.passes.size();
+    depth = gouge.maxDepth;
+  }
+  state.counters["passes"] = static_cast<double>(passes);
+  state.counters["gouge_in"] = depth;
+  state.SetLabel(surfaceName(state));
+}
+
+void BM_PlaneSection(benchmark::State& state) {
+  const scallop::Surface surface = scallop::exampleSurface(surfaceName(state));
+  double lo = 1e300, hi = -1e300;
+  for (const scallop::Vec3& p : surface.patches[0].control) lo = std::min(lo, p.z), hi = std::max(hi, p.z);
+  std::size_t level = 0;
+  for (auto _ : state) {
+    const double z = lo + (hi - lo) * (static_cast<double>(level++ % 64) + 0.5) / 64.0;
+    const scallop::PlaneSection section = scallop::planeSection(surface, {0, 0, 1}, z, 3e-4);
+    benchmark::DoNotOptimize(section.curves.data());
+  }
+  state.SetItemsProcessed(state.iterations());
+  state.SetLabel(surfaceName(state));
+}
+
+}  // namespace
+
+BENCHMARK(BM_PlanContour)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PlanRaster)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PlaneSection)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond);
