@@ -91,8 +91,22 @@ void BM_BruteForceEnvelope(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * state.range(0));
 }
 
-// Optimal slicing of the paper's surfaces at the default tolerance (0.5 degree), whole
-// pipeline (Gauss map, medial axis, eq 13, polish, certificate), and the Gauss map alone.
+// Optimal slicing of the paper's surfaces, whole pipeline (Gauss map, medial axis, eq 13,
+// polish, certificate):
+//   BM_Orient/<surface>               at the default tolerance (0.5 degree, a few hundred
+//                                     boundary segments)
+//   BM_OrientFine/<surface>_100k      at the tolerance that gives ~100,000 Gauss-map boundary
+//                                     segments (issue item 7; one iteration, tens of seconds,
+//                                     nearly all of it in the Gauss map); counters: segments,
+//                                     alpha_deg
+// and its stages alone, at the default tolerance, for the breakdown (the polish and eq 13 are
+// BM_OrientNoCertificate less BM_GaussMap less BM_OrientMedialAxis):
+//   BM_GaussMap/<surface>             the symmetrized Gauss map
+//   BM_OrientMedialAxis/<surface>     the medial axis of its projected complement
+//   BM_OrientNoCertificate/<surface>  the pipeline without the certificate
+//   BM_OrientCertificate/<surface>    the Bernstein-form certificate at N*, alpha* - 1e-7
+constexpr double kDegree = 3.14159265358979323846 / 180.0;
+
 void BM_Orient(benchmark::State& state, const char* name) {
   const scallop::Surface surface = scallop::exampleSurface(name);
   for (auto _ : state) {
@@ -101,14 +115,68 @@ void BM_Orient(benchmark::State& state, const char* name) {
   }
 }
 
+void BM_OrientFine(benchmark::State& state, const char* name, double toleranceDeg) {
+  const scallop::Surface surface = scallop::exampleSurface(name);
+  scallop::OptimalSlicingOptions options;
+  options.toleranceRad = toleranceDeg * kDegree;
+  scallop::OptimalSlicing result;
+  for (auto _ : state) {
+    result = scallop::optimalSlicing(surface, options);
+    // A copy: DoNotOptimize on the kept result's double clobbers it with Debian's Google
+    // Benchmark 1.7.1 and GCC 12 at -O2 (alpha_deg read 2e-312; cf. google/benchmark#903).
+    double alpha = result.alphaRad;
+    benchmark::DoNotOptimize(alpha);
+  }
+  state.counters["segments"] = static_cast<double>(result.gaussMap.boundarySegments);
+  state.counters["alpha_deg"] = result.alphaRad / kDegree;
+}
+
+void BM_OrientNoCertificate(benchmark::State& state, const char* name) {
+  const scallop::Surface surface = scallop::exampleSurface(name);
+  scallop::OptimalSlicingOptions options;
+  options.certify = false;
+  for (auto _ : state) {
+    scallop::OptimalSlicing result = scallop::optimalSlicing(surface, options);
+    benchmark::DoNotOptimize(result.alphaRad);
+  }
+}
+
+void BM_OrientCertificate(benchmark::State& state, const char* name) {
+  const scallop::Surface surface = scallop::exampleSurface(name);
+  scallop::OptimalSlicingOptions options;
+  options.certify = false;
+  const scallop::OptimalSlicing result = scallop::optimalSlicing(surface, options);
+  std::size_t cells = 0;
+  for (auto _ : state) {
+    cells = 0;
+    const bool proven = scallop::certifyClearance(surface, result.normal, result.alphaRad - 1e-7, cells);
+    benchmark::DoNotOptimize(proven);
+  }
+  state.counters["cells"] = static_cast<double>(cells);
+}
+
 void BM_GaussMap(benchmark::State& state, const char* name) {
   const scallop::Surface surface = scallop::exampleSurface(name);
   scallop::GaussMapOptions options;
-  options.toleranceRad = 0.5 * 3.14159265358979323846 / 180.0;
+  options.toleranceRad = scallop::OptimalSlicingOptions{}.toleranceRad;
   for (auto _ : state) {
     scallop::GaussMap map = scallop::symmetrizedGaussMap(surface, options);
     benchmark::DoNotOptimize(map.boundarySegments);
   }
+}
+
+void BM_OrientMedialAxis(benchmark::State& state, const char* name) {
+  scallop::GaussMapOptions options;
+  options.toleranceRad = scallop::OptimalSlicingOptions{}.toleranceRad;
+  scallop::PlanarDomain domain;
+  domain.loops = scallop::symmetrizedGaussMap(scallop::exampleSurface(name), options).loops;
+  for (auto _ : state) {
+    scallop::MedialAxis axis = scallop::medialAxis(domain);
+    benchmark::DoNotOptimize(axis.edges.data());
+  }
+  std::size_t segments = 0;
+  for (const auto& loop : domain.loops) segments += loop.size();
+  state.counters["segments"] = static_cast<double>(segments);
 }
 
 // The medial axis (Boost.Polygon's Voronoi diagram, validated) of a wavy annulus with
@@ -139,6 +207,16 @@ BENCHMARK_CAPTURE(BM_Orient, paper1, "paper-1")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Orient, paper2, "paper-2")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_GaussMap, paper1, "paper-1")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_GaussMap, paper2, "paper-2")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_OrientMedialAxis, paper1, "paper-1")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_OrientMedialAxis, paper2, "paper-2")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_OrientNoCertificate, paper1, "paper-1")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_OrientNoCertificate, paper2, "paper-2")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_OrientCertificate, paper1, "paper-1")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_OrientCertificate, paper2, "paper-2")->Unit(benchmark::kMillisecond);
+// The tolerances that give ~100,000 boundary segments: 103,494 on paper-1 at 0.0033 degree,
+// 95,127 on paper-2 at 0.001 (its count jumps to 151,711 at 0.0009).
+BENCHMARK_CAPTURE(BM_OrientFine, paper1_100k, "paper-1", 0.0033)->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(BM_OrientFine, paper2_100k, "paper-2", 0.001)->Iterations(1)->Unit(benchmark::kSecond);
 BENCHMARK(BM_MedialAxis)->Arg(1000)->Arg(10000)->Arg(100000)->Unit(benchmark::kMillisecond);
 
 BENCHMARK(BM_ScallopHull)->RangeMultiplier(2)->Range(1 << 10, 1 << 23)->Unit(benchmark::kMillisecond);

@@ -9,8 +9,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstddef>
-#include <cstdio>  // TRACE
-#include <cstdlib>  // TRACE
 #include <limits>
 #include <utility>
 #include <vector>
@@ -26,8 +24,13 @@
 namespace scallop {
 namespace {
 
-// The certificate proves alpha* less this (1e-6 degree-ish): the polish finds the true
-// local maxima of |n . N*| to about 1e-12, so a larger gap means a missed maximum.
+// The certificate proves alpha* less this (6e-6 degree). The polish's contacts are Newton
+// accurate (|n . N*| to rounding), so the margin is not for their error but keeps the
+// subdivision shallow: near a contact the certified polynomial's minimum is about
+// margin sin(2 alpha*) |N|^2, which cells of side ~sqrt(margin) resolve. On the paper's
+// surfaces depth 14 proves margins down to 1e-9 (77 / 165 cells at 1e-7, 101 / 213 at 1e-9,
+// failing at 1e-10): 1e-7 leaves two decades of headroom for more curved surfaces, in under
+// a millisecond.
 constexpr double kCertificateMarginRad = 1e-7;
 
 Bernstein1 constant(double c) { return Bernstein1{{c}}; }
@@ -166,11 +169,18 @@ Vec3 bestDirectionForCurve(const std::vector<Vec3>& normals) {
 // where W is indefinite (the -c_i I of the sphere): the box keeps the problem bounded.
 // Acceptance by the true objective: rho = (F(N) - F(N(d))) / (F(N) - model(d)), F from a
 // full contact search; accepted when rho > 0.01, Delta doubled when rho > 0.75 at the box's
-// edge, cut to |d| / 4 when rho < 0.25. The Maratos effect: on a curved ridge the linearised
-// constraints put N(d) O(|d|^2) off the ridge, where F grows at first order, so that a good
-// step can look bad; a second-order correction (Fletcher) re-solves the QP with each c_i
-// replaced by f_i(N(d)) - g_i . d (the constraint's observed curvature), which lands on the
-// ridge to O(|d|^3), before the step is rejected.
+// edge, halved to |d| / 2 when an accepted rho < 0.25, cut to |d| / 4 on a rejection. The
+// Maratos effect: on a curved ridge the linearised constraints put N(d) O(|d|^2) off the
+// ridge, where F grows at first order, so that a good step can look bad; when rho < 0.25 a
+// second-order correction (Fletcher) re-solves the QP with each c_i replaced by
+// f_i(N(d)) - g_i . d (the constraint's observed curvature), which lands on the ridge to
+// O(|d|^3), and the better of the two steps is judged. Stop when the model promises less
+// than the rounding of F, or after a step below 1e-10 rad.
+// Measured (step lengths |d|, from the medial axis's circle): paper-1, a vertex of three
+// contacts, 2.7e-4, 1.9e-8, done; paper-2, four contacts level by symmetry, 6.5e-3, 4.4e-5,
+// 1.8e-9; an elliptic paraboloid (the test's), an edge of two contacts, 4.3e-3, 3.0e-7; random
+// patches 2.7e-3, 2.4e-6, 1.7e-12. A handful of steps, each a contact search of ~20 Newton
+// climbs: ~1 ms per rival on a bicubic patch.
 
 // Patch parameter grid of the contact search: the unit normals at its (kGrid + 1)^2 points
 // are computed once, and each search only takes their dot products with N.
@@ -178,8 +188,12 @@ constexpr int kGrid = 32;
 // The highest grid peaks climbed by each search (a flat stretch of |n . N|, N orthogonal to
 // a whole family of normals, makes every sample a peak; only the top ones can matter).
 constexpr std::size_t kClimbed = 16;
-// Contacts within this of the top enter the QP beyond those the trust region can reach.
+// Contacts within this of the top always enter the QP (level with it up to rounding),
+// however small the trust region.
 constexpr double kActiveMargin = 1e-9;
+// At most this many contacts (the highest) enter the QP: its enumeration is cubic in them,
+// and a lower one that overtakes the top within the step shows in the true objective.
+constexpr std::size_t kModelContacts = 10;
 // Model decreases below this are rounding noise of F (a few ulps of values <= 1).
 constexpr double kNoiseF = 1e-15;
 
@@ -475,6 +489,38 @@ class ContactFinder {
     return out;
   }
 
+  // Seeds independent of the Gauss map: the `count` best directions of a Fibonacci lattice
+  // of `directions` on the upper hemisphere (+-N slice alike, so it covers every axis),
+  // ranked by the grid's max |n . N| and more than `separation` apart. The medial axis
+  // finds the basin when the Gauss map is right; these catch a map that missed normals (its
+  // circle then claims more clearance than the surface has, e.g. 63.0 against a true
+  // optimum of 57.8 degrees on a random two-patch surface) or covers a basin. O(directions
+  // x grid points): a few milliseconds per patch.
+  std::vector<Vec3> latticeSeeds(int directions, std::size_t count, double separation) const {
+    std::vector<std::pair<double, Vec3>> scored;
+    scored.reserve(static_cast<std::size_t>(directions));
+    const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
+    for (int k = 0; k < directions; ++k) {
+      const double z = 1.0 - (k + 0.5) / directions;
+      const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+      const Vec3 m{r * std::cos(golden * k), r * std::sin(golden * k), z};
+      double worst = 0.0;
+      for (const std::vector<Vec3>& grid : grids_) {
+        for (const Vec3& n : grid) worst = std::max(worst, std::abs(dot(n, m)));
+      }
+      scored.push_back({worst, m});
+    }
+    std::sort(scored.begin(), scored.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    std::vector<Vec3> seeds;
+    for (const auto& [worst, m] : scored) {
+      if (seeds.size() == count) break;
+      bool distinct = true;
+      for (const Vec3& q : seeds) distinct = distinct && std::acos(std::min(1.0, std::abs(dot(q, m)))) > separation;
+      if (distinct) seeds.push_back(m);
+    }
+    return seeds;
+  }
+
  private:
   std::vector<NormalField> fields_;
   std::vector<std::vector<Vec3>> grids_;
@@ -630,6 +676,8 @@ double largest(const std::vector<Contact>& contacts) {
 Vec3 polishDirection(const ContactFinder& finder, Vec3 n, double initialRadius, double& value) {
   std::vector<Contact> contacts = finder.search(n, {});
   double f = largest(contacts);
+  value = f;
+  if (contacts.empty()) return n;
   double radius = initialRadius;
   for (int iteration = 0; iteration < 200 && radius > 1e-12; ++iteration) {
     const Vec3 e1 = orthogonal(n);
@@ -639,7 +687,7 @@ Vec3 polishDirection(const ContactFinder& finder, Vec3 n, double initialRadius, 
     std::vector<Contact> active;
     std::vector<ModelContact> models;
     for (const Contact& c : contacts) {
-      if (c.value < f - 3.0 * radius - kActiveMargin) break;
+      if (c.value < f - 3.0 * radius - kActiveMargin || active.size() == kModelContacts) break;
       active.push_back(c);
       models.push_back(modelOf(c, e1, e2));
     }
@@ -675,7 +723,6 @@ Vec3 polishDirection(const ContactFinder& finder, Vec3 n, double initialRadius, 
       }
     }
     const double length = std::max(std::abs(step.x), std::abs(step.y));
-    if (std::getenv("POLISH_TRACE")) std::fprintf(stderr, "it %d F %.17g radius %.3g active %zu step %.3g pred %.3g ratio %.4f\n", iteration, f, radius, active.size(), length, predicted, ratio);  // TRACE
     if (ratio > 0.01) {
       n = trial;
       contacts = std::move(trialContacts);
@@ -688,10 +735,6 @@ Vec3 polishDirection(const ContactFinder& finder, Vec3 n, double initialRadius, 
     }
   }
   value = f;
-  if (std::getenv("POLISH_TRACE")) {  // TRACE
-    std::fprintf(stderr, "final N (%.12f %.12f %.12f) F %.17g\n", n.x, n.y, n.z, f);  // TRACE
-    for (std::size_t i = 0; i < contacts.size() && i < 6; ++i) std::fprintf(stderr, "   contact patch %zu u %.12f v %.12f value %.17g free %d%d fuu %.3g fvv %.3g\n", contacts[i].patch, contacts[i].u, contacts[i].v, contacts[i].value, contacts[i].freeU, contacts[i].freeV, contacts[i].height.fuu, contacts[i].height.fvv);  // TRACE
-  }  // TRACE
   return n;
 }
 
@@ -713,19 +756,23 @@ bool provePositive(const Bernstein2& p, int depth, int maxDepth, std::size_t& ce
 
 // The medial axis needs simple, disjoint loops (medial_axis.hpp). At fine tolerances the
 // Gauss map's polygon union (Boost.Polygon, on an integer grid) can return a loop that runs
-// back and forth along a nearly straight stretch: a zero-width zigzag whose segments cross
-// by a few grid steps, with a sliver hole of two or three points beside it (paper-1 at
-// 0.005 degree: 17 such vertices among 57,804 segments). Every vertex where the loop turns
-// back within a triangle thinner than `width` (twice its area over its longest side) is
-// removed, and a loop left with less than 3 points or an area below width^2 is dropped:
-// the boundary moves by less than `width`, far below the tolerance (and the polish works on
-// the true surface anyway). O(n): a stack pass, then the junction of the loop's two ends.
-std::vector<std::vector<Vec2>> withoutSpikes(const std::vector<std::vector<Vec2>>& loops, double width) {
-  auto spike = [width](const Vec2& p, const Vec2& q, const Vec2& r) {
+// back and forth along a nearly straight stretch, a zigzag a few grid steps wide whose
+// segments cross or touch, and sliver holes of three or four points beside it (paper-1 at
+// 0.005 degree: 17 such vertices among 57,804 segments; paper-2 at 0.0009 degree: 51 among
+// 151,711, the zigzags up to 5e-8 wide in the plane, 0.3% of the tolerance there). Every
+// vertex where the loop turns back within a triangle thinner than `widthRad` on the sphere
+// (twice its area over its longest side, in the plane, where the projection stretches
+// lengths by (1 + |p|^2) / 2) is removed, and a loop left with less than 3 points or an area
+// below the square of that width dropped: the boundary moves by less than `widthRad`, below
+// the polygon's own tolerance (and the polish works on the true surface anyway). O(n): a
+// stack pass, then the junction of the loop's two ends.
+std::vector<std::vector<Vec2>> withoutSpikes(const std::vector<std::vector<Vec2>>& loops, double widthRad) {
+  auto width = [widthRad](const Vec2& q) { return widthRad * 0.5 * (1.0 + dot(q, q)); };
+  auto spike = [&width](const Vec2& p, const Vec2& q, const Vec2& r) {
     const Vec2 a = q - p;
     const Vec2 b = r - q;
     const double longest = std::max({norm(a), norm(b), norm(a + b)});
-    return dot(a, b) < 0.0 && std::abs(cross(a, b)) <= width * longest;
+    return dot(a, b) < 0.0 && std::abs(cross(a, b)) <= width(q) * longest;
   };
   std::vector<std::vector<Vec2>> out;
   for (const std::vector<Vec2>& loop : loops) {
@@ -742,9 +789,7 @@ std::vector<std::vector<Vec2>> withoutSpikes(const std::vector<std::vector<Vec2>
     for (bool changed = true; changed && kept.size() - first >= 3;) {
       changed = false;
       const std::size_t n = kept.size();
-      if (kept[n - 1] == kept[first]) {
-        kept.pop_back(), changed = true;
-      } else if (spike(kept[n - 2], kept[n - 1], kept[first])) {
+      if (kept[n - 1] == kept[first] || spike(kept[n - 2], kept[n - 1], kept[first])) {
         kept.pop_back(), changed = true;
       } else if (spike(kept[n - 1], kept[first], kept[first + 1])) {
         ++first, changed = true;
@@ -753,8 +798,9 @@ std::vector<std::vector<Vec2>> withoutSpikes(const std::vector<std::vector<Vec2>
     kept.erase(kept.begin(), kept.begin() + static_cast<std::ptrdiff_t>(first));
     if (kept.size() < 3) continue;
     double area2 = 0.0;
-    for (std::size_t i = 0; i < kept.size(); ++i) area2 += cross(kept[i], kept[(i + 1) % kept.size()]);
-    if (0.5 * std::abs(area2) <= width * width) continue;
+    for (std::size_t i = 0; i < kept.size(); ++i) area2 += cross(kept[i] - kept[0], kept[(i + 1) % kept.size()] - kept[0]);
+    const double w = width(kept[0]);
+    if (0.5 * std::abs(area2) <= w * w) continue;
     out.push_back(std::move(kept));
   }
   return out;
@@ -791,7 +837,6 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
   GaussMapOptions gaussOptions;
   gaussOptions.toleranceRad = tol;
   result.gaussMap = symmetrizedGaussMap(surface, gaussOptions);
-  if (std::getenv("POLISH_TRACE")) std::fprintf(stderr, "TIMER %s %.6f\n", "gauss", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());  // TRACE
   const GaussMap& map = result.gaussMap;
   result.pole = map.pole;
   const Rotation3 back = transpose(map.toPoleFrame);
@@ -816,12 +861,9 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
   } else {
     if (map.loops.empty()) throw Error("the complement of the Gauss map is empty: no slicing direction avoids every surface normal");
     PlanarDomain domain;
-    // The zigzags' width bound: 1e-3 of the tolerance on the sphere is at least 5e-4 of it
-    // in the plane (the projection stretches angles by (1 + |p|^2) / 2 >= 1/2).
-    domain.loops = withoutSpikes(map.loops, 5e-4 * tol);
+    domain.loops = withoutSpikes(map.loops, 1e-2 * tol);
     if (domain.loops.empty()) throw Error("the complement of the Gauss map is empty: no slicing direction avoids every surface normal");
     const MedialAxis axis = medialAxis(domain);
-  if (std::getenv("POLISH_TRACE")) std::fprintf(stderr, "TIMER %s %.6f\n", "medial", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());  // TRACE
     result.medialAxisEdges = axis.edges.size();
     result.medialAxisRebuilds = axis.rebuilds;
     double bestAlpha = -1.0;
@@ -847,7 +889,6 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
       }
     }
     if (bestAlpha < 0.0) throw Error("the medial axis of the Gauss map's complement has no usable circle");
-  if (std::getenv("POLISH_TRACE")) std::fprintf(stderr, "TIMER %s %.6f\n", "eq13", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());  // TRACE
     result.alphaRad = alphaOfPlaneCircleRad(norm(result.circle.center), result.circle.radius);
     result.normal = apply(back, directionOfPlaneCircle(result.circle.center, result.circle.radius));
     result.sphereCircle = {result.normal, result.alphaRad};
@@ -872,8 +913,10 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
   // along the family of normals, where the pattern search only wanders.)
   if (result.method == "medial-axis") {
     // Every rival is polished: the polygonal map can rank close rival optima wrongly by a
-    // few tolerances, and each polish is cheap (a few Newton steps).
+    // few tolerances, and each polish is cheap (a few Newton steps). Then the lattice's
+    // seeds (see latticeSeeds); the medial axis's rivals come first and win ties.
     const ContactFinder finder(surface);
+    for (const Vec3& seed : finder.latticeSeeds(2000, 4, 2.0 * std::numbers::pi / 180.0)) rivals.push_back(seed);
     double bestValue = 2.0;
     for (const Vec3& seed : rivals) {
       double value = 0.0;
@@ -883,7 +926,6 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
     result.alphaRad = std::acos(std::min(1.0, bestValue));
     result.sphereCircle = {result.normal, result.alphaRad};
   }
-  if (std::getenv("POLISH_TRACE")) std::fprintf(stderr, "TIMER %s %.6f\n", "polish", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());  // TRACE
   // Certificate: prove that no normal comes within alpha* less a small margin (what the
   // sampled-and-climbed maxima could have missed) of +-N*.
   if (options.certify) {
@@ -891,7 +933,6 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
     result.certified = certifyClearance(surface, result.normal, result.certifiedAlphaRad,
                                         result.certificateCells);
   }
-  if (std::getenv("POLISH_TRACE")) std::fprintf(stderr, "TIMER %s %.6f\n", "certificate", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());  // TRACE
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

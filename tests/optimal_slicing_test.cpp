@@ -235,6 +235,28 @@ TEST(OptimalSlicing, TwoPatchSurface) {
   expectAsGoodAsBruteForce(s, 0.5);
 }
 
+TEST(OptimalSlicing, TwoPatchSurfaceWhoseGaussMapMissesNormals) {
+  // A random two-patch surface (C0 along x = 3) on which the Gauss map at 0.5 degree misses
+  // a region of normals near the corner (u, v) = (0, 1) of the second patch (2,640 of 40,803
+  // sampled normals lie more than two tolerances inside the complement; each patch alone is
+  // right): the medial axis's best circle claims 63.0 degrees, the true optimum is 57.82 at
+  // about (0.526, 0.849, 0.055). The lattice seeds of the polish find it.
+  const double z[4][7] = {{0.6753, 1.1909, 1.2780, 0.7642, 0.6671, 0.9258, 1.0888},
+                          {0.3085, 1.3275, 1.3722, 0.5354, 0.0021, 1.1797, 0.2465},
+                          {0.5283, 1.0242, 0.4930, 0.2316, 1.0166, 0.2580, 0.6747},
+                          {0.8372, 0.5874, 1.4148, 0.6583, 1.4150, 1.4974, 1.2883}};
+  Surface s;
+  for (int part = 0; part < 2; ++part) {
+    BezierPatch p;
+    for (int j = 0; j <= 3; ++j) {
+      for (int k = 0; k <= 3; ++k) p.control.push_back({double(3 * part + k), double(j), z[j][3 * part + k]});
+    }
+    s.patches.push_back(p);
+  }
+  expectAsGoodAsBruteForce(s, 0.5);
+  EXPECT_GT(scallop::optimalSlicing(s).alphaRad, 57.8 * kDeg);
+}
+
 TEST(OptimalSlicing, EllipticParaboloidEdgeOptimumIsExact) {
   // z = a x^2 + b y^2 over [-1, 1]^2 with a < b: the Gauss image is a cap elongated along y;
   // the best direction is N* = (1, 0, 0), touching the image at the two normals of (+-1, 0)
@@ -273,7 +295,8 @@ double axisAngle(const Vec3& a, const Vec3& b, bool paper2Symmetry) {
 TEST(OptimalSlicing, ConvergesAsTheToleranceShrinks) {
   // Issue item 7: as the Gauss map's tolerance shrinks (paper-1 down to 57,804 boundary
   // segments at 0.005 degree, where the map's polygon union leaves a zigzag that the
-  // medial axis would reject; paper-2 to 8,591 at 0.01 degree; the benchmark runs 100,000),
+  // medial axis would reject; paper-2 to 3,490 at 0.02 degree, its Gauss map being slower;
+  // the benchmark runs 100,000),
   // alpha* never decreases beyond rounding and converges to the brute force's value, and N*
   // converges (successive N* closer and closer).
   struct Case {
@@ -282,7 +305,7 @@ TEST(OptimalSlicing, ConvergesAsTheToleranceShrinks) {
     bool symmetric;
   };
   for (const Case& c : {Case{"paper-1", {1.0, 0.5, 0.2, 0.05, 0.005}, false},
-                        Case{"paper-2", {1.0, 0.5, 0.2, 0.05, 0.01}, true}}) {
+                        Case{"paper-2", {1.0, 0.5, 0.2, 0.05, 0.02}, true}}) {
     SCOPED_TRACE(c.name);
     const Surface s = scallop::exampleSurface(c.name);
     const double brute = trueAlpha(s, bruteForceDirection(s));
@@ -307,8 +330,10 @@ TEST(OptimalSlicing, ConvergesAsTheToleranceShrinks) {
       previousAlpha = result.alphaRad;
       previousNormal = result.normal;
     }
-    EXPECT_GT(previousSegments, c.symmetric ? 8000u : 50000u);
-    EXPECT_NEAR(previousAlpha, brute, 0.01 * kDeg);
+    EXPECT_GT(previousSegments, c.symmetric ? 3000u : 50000u);
+    // The true alpha at N*, at least the brute force's (which, sampling, can fall short).
+    EXPECT_NEAR(previousAlpha, trueAlpha(s, previousNormal), 1e-7);
+    EXPECT_GE(previousAlpha, brute - 0.01 * kDeg);
     EXPECT_LT(previousMove, 1e-7);
   }
 }
