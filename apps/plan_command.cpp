@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <numbers>
 #include <optional>
 #include <string>
 #include <vector>
@@ -108,7 +109,7 @@ void runPlan(const PlanOptions& options) {
              "scallop plan: {} on {}: N* = ({:.4f}, {:.4f}, {:.4f}), alpha* = {:.3f} deg; spacing "
              "{:.5g}, {} planes, {} components, tool-centre length {:.4f} {}{}; {:.2f} s -> {}/\n",
              options.strategy, source, orientation.normal.x, orientation.normal.y,
-             orientation.normal.z, orientation.alphaRad * 180.0 / 3.141592653589793, report.spacing,
+             orientation.normal.z, orientation.alphaRad * 180.0 / std::numbers::pi, report.spacing,
              s.planes, s.components, s.centreLength, unitsName(surface.units), gouge,
              report.seconds + orientation.seconds, options.out);
 }

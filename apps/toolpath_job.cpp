@@ -95,16 +95,8 @@ void runRaster(const Surface& surface, const JobOptions& options, JobResult& res
     // Samples every R / 10 along the path: the bound between samples adds R / 20.
     const double spacing = options.toolRadius / 10.0;
     say(progress, fmt::format("checking the ball against the whole surface every {:.6g}", spacing));
-    const GougeReport gouge = gougeCheck(surface, result.path, spacing);
-    GougeSummary summary;
-    summary.maxDepth = gouge.maxDepth;
-    summary.signedMaxDepth = gouge.signedMaxDepth;
-    summary.depthBound = gouge.depthBound;
-    summary.sampleSpacing = spacing;
-    summary.samples = gouge.samples;
-    summary.where = gouge.deepest.center;
-    summary.pass = gouge.deepest.pass;
-    result.report.gouge = summary;
+    result.report.gouge = gougeCheck(surface, result.path, spacing);
+    result.report.gougeSampleSpacing = spacing;
   }
 }
 
@@ -116,6 +108,13 @@ JobResult runToolpathJob(const Surface& surface, const std::string& source,
   const auto start = std::chrono::steady_clock::now();
   if (!(options.toolRadius > 0.0) || !std::isfinite(options.toolRadius))
     throw Error(fmt::format("the tool radius must be positive, got {}", options.toolRadius));
+  // A ball a thousand times the size of the part is a typo (mm for inches, a missing
+  // decimal point), not a tool; beyond it the path and the gouge check lose their meaning.
+  const double size = std::max(surfaceScale(surface), 1e-300);
+  if (options.toolRadius > 1e3 * size)
+    throw Error(fmt::format("{}: the tool radius {} is more than 1000 times the surface's size "
+                            "(largest |coordinate| {} {}); check the units",
+                            source, options.toolRadius, size, unitsName(surface.units)));
   if (options.spacing.has_value() == options.scallopHeight.has_value())
     throw Error("give exactly one of --spacing and --scallop-height");
   if (options.scallopHeight && !(*options.scallopHeight < options.toolRadius))
@@ -154,8 +153,9 @@ GcodeOptions defaultGcodeOptions(const Surface& surface, const ToolPath& path,
   options.plungeFeedRate = inch ? 15.0 : 400.0;
   options.spindleRpm = 10000.0;
   options.title = title;
-  // Tips are centres - R; arcs bulge at most R above their ends' centre height... their
-  // centres are chain vertices, below the path, so the ends and line vertices bound them.
+  // The highest tip (centre - R) of the path: line ends, and the top of every arc, which
+  // lies at most its radius above its centre. The surface's control points bound the
+  // surface from above, so rapids at the safe height clear it too.
   double top = -std::numeric_limits<double>::infinity();
   for (const BezierPatch& patch : surface.patches)
     for (const Vec3& p : patch.control) top = std::max(top, p.z);

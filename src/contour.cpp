@@ -10,6 +10,7 @@
 #include "scallop/bezier.hpp"
 #include "scallop/error.hpp"
 #include "scallop/optimal_slicing.hpp"
+#include "alignment.hpp"
 
 namespace scallop {
 namespace {
@@ -24,15 +25,15 @@ double alignment(const BezierPatch& patch, const Vec3& m, double u, double v) {
   return std::abs(dot(unitNormal(patch, u, v), m));
 }
 
+// One orientation per patch, the one whose normal at the parameter centre points up, so
+// that the offset does not flip side where the surface is steep: +1 or -1 times r_u x r_v.
+double upwardSign(const BezierPatch& patch) { return unitNormal(patch, 0.5, 0.5).z >= 0.0 ? 1.0 : -1.0; }
+
 }  // namespace
 
 Vec3 upwardNormal(const Surface& surface, std::size_t patch, double u, double v) {
   const BezierPatch& p = surface.patches.at(patch);
-  const Vec3 n = unitNormal(p, u, v);
-  // One orientation per patch, the one whose centre normal points up, so that the offset
-  // does not flip side where the surface is steep.
-  const double centreZ = unitNormal(p, 0.5, 0.5).z;
-  return centreZ >= 0.0 ? n : -n;
+  return upwardSign(p) * unitNormal(p, u, v);
 }
 
 double spacingForScallopHeight(double toolRadius, double scallopHeight, double alphaRad) {
@@ -63,10 +64,7 @@ double minimumAngleBound(const Surface& surface, const Vec3& direction) {
   constexpr int kGrid = 48;
   double largest = 0.0;
   for (const BezierPatch& patch : surface.patches) {
-    struct Sample {
-      double value, u, v;
-    };
-    std::vector<Sample> samples;
+    std::vector<detail::AlignmentPeak> samples;
     for (int i = 0; i <= kGrid; ++i)
       for (int j = 0; j <= kGrid; ++j) {
         const double u = double(i) / kGrid, v = double(j) / kGrid;
@@ -74,23 +72,11 @@ double minimumAngleBound(const Surface& surface, const Vec3& direction) {
       }
     constexpr int kClimbed = 16;
     std::partial_sort(samples.begin(), samples.begin() + kClimbed, samples.end(),
-                      [](const Sample& a, const Sample& b) { return a.value > b.value; });
+                      [](const auto& a, const auto& b) { return a.value > b.value; });
     for (int s = 0; s < kClimbed; ++s) {
-      Sample c = samples[static_cast<std::size_t>(s)];
-      for (double step = 1.0 / kGrid; step > 1e-12; step *= 0.5) {
-        for (bool moved = true; moved;) {
-          moved = false;
-          for (const auto& [du, dv] : {std::pair{1, 0}, std::pair{-1, 0}, std::pair{0, 1},
-                                       std::pair{0, -1}, std::pair{1, 1}, std::pair{-1, -1},
-                                       std::pair{1, -1}, std::pair{-1, 1}}) {
-            const double u = std::clamp(c.u + du * step, 0.0, 1.0);
-            const double v = std::clamp(c.v + dv * step, 0.0, 1.0);
-            const double g = alignment(patch, m, u, v);
-            if (g > c.value) c = {g, u, v}, moved = true;
-          }
-        }
-      }
-      largest = std::max(largest, c.value);
+      const detail::AlignmentPeak peak = detail::climbAlignment(
+          patch, m, samples[static_cast<std::size_t>(s)], 1.0 / kGrid, 1e-12);
+      largest = std::max(largest, peak.value);
     }
   }
   const double estimate = std::acos(std::min(1.0, largest));
@@ -106,6 +92,27 @@ double minimumAngleBound(const Surface& surface, const Vec3& direction) {
     if (certifyClearance(surface, m, bound, cells)) return bound;
   }
   return 0.0;
+}
+
+PlaneRange planeRange(const Surface& surface, const Vec3& unitNormal, double spacing,
+                      const char* what) {
+  PlaneRange range;
+  range.lo = std::numeric_limits<double>::infinity();
+  range.hi = -range.lo;
+  for (const BezierPatch& patch : surface.patches)
+    for (const Vec3& p : patch.control) {
+      range.lo = std::min(range.lo, dot(unitNormal, p));
+      range.hi = std::max(range.hi, dot(unitNormal, p));
+    }
+  range.first = std::ceil(range.lo / spacing);
+  range.last = std::floor(range.hi / spacing);
+  // At about 2,000 sections a second, 100,000 planes already take a minute; more is a
+  // spacing typed in the wrong units, and would run for hours.
+  if (range.last - range.first >= kMaxPlanes)
+    throw Error(fmt::format("{} {} gives {:.0f} planes across the surface; more than 100,000 "
+                            "is not a tool path (check the units)",
+                            what, spacing, range.last - range.first + 1));
+  return range;
 }
 
 ContourPaths contourPaths(const Surface& surface, const ContourOptions& options) {
@@ -126,23 +133,10 @@ ContourPaths contourPaths(const Surface& surface, const ContourOptions& options)
   out.spacing = options.spacing;
   out.path.units = surface.units;
   out.path.toolRadius = options.toolRadius;
-  // The surface lies in the convex hull of its control points: N . r spans at most their
-  // range, so the planes k Delta with k in [ceil(lo / Delta), floor(hi / Delta)] are all
-  // that can cut it.
-  double lo = std::numeric_limits<double>::infinity();
-  double hi = -lo;
-  for (const BezierPatch& patch : surface.patches)
-    for (const Vec3& p : patch.control) {
-      lo = std::min(lo, dot(out.normal, p));
-      hi = std::max(hi, dot(out.normal, p));
-    }
-  const double first = std::ceil(lo / options.spacing);
-  const double last = std::floor(hi / options.spacing);
-  if (last - first > 1e7)
-    throw Error(fmt::format("the plane spacing {} gives {:.0f} planes across the surface; "
-                            "more than 10 million is not a tool path",
-                            options.spacing, last - first + 1));
-  for (double kk = first; kk <= last; kk += 1.0) {
+  const PlaneRange range = planeRange(surface, out.normal, options.spacing, "the plane spacing");
+  std::vector<double> up;  // upwardSign per patch, once rather than per vertex
+  for (const BezierPatch& patch : surface.patches) up.push_back(upwardSign(patch));
+  for (double kk = range.first; kk <= range.last; kk += 1.0) {
     const long long k = static_cast<long long>(kk);
     const double offset = kk * options.spacing;
     PlaneSection section = planeSection(surface, out.normal, offset, tolerance);
@@ -156,7 +150,8 @@ ContourPaths contourPaths(const Surface& surface, const ContourOptions& options)
       bool atStart = true;
       Vec3 previous;
       for (const SectionPoint& p : curve.points) {
-        const Vec3 centre = p.point + options.toolRadius * upwardNormal(surface, p.patch, p.u, p.v);
+        const Vec3 normal = up[p.patch] * unitNormal(surface.patches[p.patch], p.u, p.v);
+        const Vec3 centre = p.point + options.toolRadius * normal;
         if (atStart) {
           pass.start = centre;
           atStart = false;
@@ -173,7 +168,7 @@ ContourPaths contourPaths(const Surface& surface, const ContourOptions& options)
   if (out.sections.empty())
     throw Error(fmt::format(
         "no plane N . r = k * {} with N = ({}, {}, {}) cuts the surface (N . r spans [{}, {}])",
-        options.spacing, out.normal.x, out.normal.y, out.normal.z, lo, hi));
+        options.spacing, out.normal.x, out.normal.y, out.normal.z, range.lo, range.hi));
   return out;
 }
 

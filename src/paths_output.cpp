@@ -141,10 +141,10 @@ std::string pathsToJson(const PathsReport& report, const ToolPath& path) {
     gouge["max_depth"] = report.gouge->maxDepth;
     gouge["signed_max_depth"] = report.gouge->signedMaxDepth;
     gouge["depth_bound"] = report.gouge->depthBound;
-    gouge["sample_spacing"] = report.gouge->sampleSpacing;
+    gouge["sample_spacing"] = report.gougeSampleSpacing;
     gouge["samples"] = report.gouge->samples;
-    gouge["where"] = vec(report.gouge->where);
-    gouge["pass"] = report.gouge->pass;
+    gouge["where"] = vec(report.gouge->deepest.center);
+    gouge["pass"] = report.gouge->deepest.pass;
     document["gouge"] = gouge;
   } else {
     document["gouge"] = nullptr;
@@ -162,11 +162,16 @@ std::string pathsToJson(const PathsReport& report, const ToolPath& path) {
   }
   document["seconds"] = report.seconds;
   Json passes = Json::array();
+  auto finite = [](const Vec3& p) {
+    return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+  };
+  for (std::size_t i = 0; i < path.passes.size(); ++i) {
+    const ToolPass& pass = path.passes[i];
+    bool ok = finite(pass.start);
+    for (const ToolMove& move : pass.moves) ok = ok && finite(move.end) && finite(move.center);
+    if (!ok) throw Error(fmt::format("cannot write the tool path: pass {} has a position that is not finite", i));
+  }
   for (const ToolPass& pass : path.passes) {
-    for (const ToolMove& move : pass.moves) {
-      if (!std::isfinite(move.end.x) || !std::isfinite(move.end.y) || !std::isfinite(move.end.z))
-        throw Error("cannot write the tool path: a position is not finite");
-    }
     Json p;
     p["retract_before"] = pass.retractBefore;
     p["start"] = vec(pass.start);

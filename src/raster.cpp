@@ -12,6 +12,7 @@
 #include "scallop/bezier.hpp"
 #include "scallop/error.hpp"
 #include "scallop/path_sampling.hpp"
+#include "alignment.hpp"
 
 namespace scallop {
 namespace {
@@ -381,20 +382,9 @@ class AngleObjective {
       std::partial_sort(seeds.begin(), seeds.begin() + static_cast<std::ptrdiff_t>(count),
                         seeds.end(), [](const Seed& x, const Seed& y) { return x.value > y.value; });
       for (std::size_t k = 0; k < count; ++k) {
-        Seed c = seeds[k];
-        for (double step = 1.0 / kAngleGrid; step > 1e-10; step *= 0.5) {
-          for (bool moved = true; moved;) {
-            moved = false;
-            for (const auto& [du, dv] : {std::pair{1, 0}, std::pair{-1, 0}, std::pair{0, 1},
-                                         std::pair{0, -1}, std::pair{1, 1}, std::pair{-1, -1},
-                                         std::pair{1, -1}, std::pair{-1, 1}}) {
-              const double u = std::clamp(c.u + du * step, 0.0, 1.0);
-              const double v = std::clamp(c.v + dv * step, 0.0, 1.0);
-              const double g = std::abs(dot(unitNormal(patch, u, v), e));
-              if (g > c.value) c = {g, u, v}, moved = true;
-            }
-          }
-        }
+        const Seed& seed = seeds[k];
+        const detail::AlignmentPeak c =
+            detail::climbAlignment(patch, e, {seed.value, seed.u, seed.v}, 1.0 / kAngleGrid, 1e-10);
         largest = std::max(largest, c.value);
       }
     }
@@ -499,22 +489,10 @@ RasterPaths rasterPaths(const Surface& surface, const RasterOptions& options) {
   out.path.units = surface.units;
   out.path.toolRadius = radius;
 
-  // As contour.cpp: e . r over the control points bounds e . r over the surface.
-  double lo = kInf, hi = -kInf;
-  for (const BezierPatch& patch : surface.patches)
-    for (const Vec3& p : patch.control) {
-      lo = std::min(lo, dot(frame.e, p));
-      hi = std::max(hi, dot(frame.e, p));
-    }
-  const double first = std::ceil(lo / out.spacing);
-  const double last = std::floor(hi / out.spacing);
-  if (last - first > 1e7)
-    throw Error(fmt::format("the step-over {} gives {:.0f} planes across the surface; "
-                            "more than 10 million is not a tool path",
-                            out.spacing, last - first + 1));
+  const PlaneRange range = planeRange(surface, frame.e, out.spacing, "the step-over");
 
   const HeightBound heights(surface, tolerance, 1e-12 * scale);
-  for (double kk = first; kk <= last; kk += 1.0) {
+  for (double kk = range.first; kk <= range.last; kk += 1.0) {
     const double w = kk * out.spacing;
     PlaneSection section = planeSection(surface, frame.e, w, tolerance);
     out.stats.touchPoints += section.touchPoints.size();
@@ -572,7 +550,7 @@ RasterPaths rasterPaths(const Surface& surface, const RasterOptions& options) {
   if (out.sections.empty())
     throw Error(fmt::format(
         "no plane e . r = k * {} with e = ({}, {}, 0) cuts the surface (e . r spans [{}, {}])",
-        out.spacing, frame.e.x, frame.e.y, lo, hi));
+        out.spacing, frame.e.x, frame.e.y, range.lo, range.hi));
   return out;
 }
 

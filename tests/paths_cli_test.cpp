@@ -176,6 +176,8 @@ TEST_F(PathsCli, BadInputFailsWithMessageAndWritesNothing) {
       {"--example paper-1 --tool-radius 0.25 --scallop-height 0.25", {"scallop height", "smaller"}},
       {"--example paper-1 --tool-radius 0.25 --scallop-height 0.3", {"scallop height", "0.3"}},
       {"--example paper-1 --tool-radius 0.25 --spacing 100 --normal 0,0,1", {"cuts the surface"}},
+      {"--example paper-1 --tool-radius 6350 --spacing 0.1", {"tool radius", "1000 times", "units"}},
+      {"--example paper-1 --tool-radius 0.25 --spacing 1e-5", {"spacing", "100,000", "units"}},
       {"--example paper-1 --tool-radius 0.25 --scallop-height 0.001 --normal 0,0,1",
        {"tangency", "spacing"}},
       {"folded.json --tool-radius 1 --spacing 1 --strategy raster --angle 0", {"folded.json", "graph"}},

@@ -69,6 +69,21 @@ struct ContourPaths {
 /// The contour paths of `surface` (see the contract); throws scallop::Error on bad options.
 ContourPaths contourPaths(const Surface& surface, const ContourOptions& options);
 
+/// The planes n . r = k Delta that can cut a surface: the surface lies in the convex hull of
+/// its control points, so n . r spans at most [lo, hi], their range, and only k in
+/// [first, last] = [ceil(lo / Delta), floor(hi / Delta)] can cut it (first > last: none).
+/// Shared by the contour and raster strategies. Throws scallop::Error when that is more
+/// than kMaxPlanes planes (`what` names the spacing in the message).
+constexpr double kMaxPlanes = 100000.0;
+struct PlaneRange {
+  double lo = 0.0;
+  double hi = 0.0;
+  double first = 0.0;  ///< an integer
+  double last = 0.0;   ///< an integer
+};
+PlaneRange planeRange(const Surface& surface, const Vec3& unitNormal, double spacing,
+                      const char* what);
+
 /// Delta = 2 sqrt(2 R H - H^2) sin(alpha): the plane spacing that keeps the scallop height
 /// below H where the planes meet the surface at angle >= alpha (radians) to its normal.
 /// Throws scallop::Error unless 0 < H < R and 0 < alpha <= pi / 2.

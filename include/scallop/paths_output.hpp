@@ -18,23 +18,12 @@
 #include <vector>
 
 #include "scallop/contour.hpp"
+#include "scallop/gouge.hpp"
 #include "scallop/surface.hpp"
 #include "scallop/toolpath.hpp"
 #include "scallop/vector.hpp"
 
 namespace scallop {
-
-/// The deepest interference of the ball with the surface along the path (gouge.hpp),
-/// summarised for the report.
-struct GougeSummary {
-  double maxDepth = 0.0;        ///< >= 0, surface units
-  double signedMaxDepth = 0.0;  ///< < 0: the closest approach left this much clearance
-  double depthBound = 0.0;      ///< proven bound between samples (maxDepth + spacing / 2)
-  double sampleSpacing = 0.0;
-  std::size_t samples = 0;
-  Vec3 where;                   ///< ball centre where the deepest interference happens
-  std::size_t pass = 0;
-};
 
 /// The optimal slicing orientation, when the job computed it (optimal_slicing.hpp).
 struct OrientationSummary {
@@ -56,7 +45,8 @@ struct PathsReport {
   double alphaRad = 0.0;           ///< proven least angle between N and +-n
   std::optional<double> feedAngleRad;   ///< raster: the feed direction's angle from +x
   PathStats stats;
-  std::optional<GougeSummary> gouge;
+  std::optional<GougeReport> gouge;  ///< raster: the ball against the whole surface
+  double gougeSampleSpacing = 0.0;   ///< the spacing the gouge check sampled at
   std::optional<OrientationSummary> orientation;
   double seconds = 0.0;
 };
