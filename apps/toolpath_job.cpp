@@ -87,6 +87,8 @@ void runRaster(const Surface& surface, const JobOptions& options, JobResult& res
   result.report.alphaRad = paths.alphaRad;
   result.report.feedAngleRad = paths.angleRad;
   result.report.stats = paths.stats;
+  result.report.linkLength = paths.linkLength;
+  result.report.unclearedEnds = paths.unclearedEnds;
   for (const RasterSection& section : paths.sections)
     for (const SectionCurve& curve : section.section.curves)
       result.contactCurves.push_back(curvePoints(curve));

@@ -135,6 +135,8 @@ std::string pathsToJson(const PathsReport& report, const ToolPath& path) {
   stats["centre_length"] = report.stats.centreLength;
   stats["touch_points"] = report.stats.touchPoints;
   stats["passes"] = path.passes.size();
+  if (report.linkLength) stats["link_length"] = *report.linkLength;
+  if (report.unclearedEnds) stats["uncleared_ends"] = *report.unclearedEnds;
   document["stats"] = stats;
   if (report.gouge) {
     Json gouge;

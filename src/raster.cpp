@@ -11,6 +11,7 @@
 
 #include "scallop/bezier.hpp"
 #include "scallop/error.hpp"
+#include "scallop/gouge.hpp"
 #include "scallop/path_sampling.hpp"
 #include "alignment.hpp"
 
@@ -332,6 +333,92 @@ class HeightBound {
 };
 
 // ---------------------------------------------------------------------------------------
+// Ways off the surface at a pass's ends
+// ---------------------------------------------------------------------------------------
+
+// Proves that the ball, its centre moving along [a, b], stays at least `need` from the
+// surface: sphere tracing on the distance's proven lower bound. dist(., surface) is
+// 1-Lipschitz, so a centre p with dist(p) >= need + m clears every centre within m of p;
+// each step advances by that margin. Gives up (false) when the margin falls below
+// `minStep` (the path comes too close, or creeps along the limit) or after kMaxSteps.
+bool segmentClears(const SurfaceDistance& distance, Vec3 a, Vec3 b, double need,
+                   double reach, double minStep) {
+  constexpr int kMaxSteps = 4000;
+  const double length = norm(b - a);
+  // A coarse look first, at steps of `reach` / 16: most failing candidates cut in visibly
+  // somewhere, and one cheap query (settled by a few boxes, cutoff `need`) shows it.
+  const int coarse = static_cast<int>(std::min(256.0, std::ceil(16.0 * length / reach)));
+  for (int i = 1; i <= coarse; ++i) {
+    if (distance.closest(a + (b - a) * (double(i) / coarse), need).distance < need) return false;
+  }
+  double t = 0.0;
+  double stride = minStep;  // the last margin
+  for (int step = 0; step < kMaxSteps; ++step) {
+    const Vec3 p = length > 0.0 ? a + (b - a) * (t / length) : a;
+    // The cutoff: a bound tighter than need + twice the last margin (or reach) is not worth
+    // its cells; the margin can then double from one step to the next, no more.
+    const double cutoff = need + std::min(reach, 2.0 * stride);
+    const double margin = distance.closest(p, cutoff).lowerBound - need;
+    if (!(margin > minStep)) return false;
+    if (t + margin >= length) return true;
+    t += margin;
+    stride = std::max(margin, 64.0 * minStep);
+  }
+  return false;
+}
+
+// A way off the surface from the ball centre c at one end of a pass: a horizontal move to
+// `point`, then straight up to the clear height there, along which the ball never cuts
+// deeper than max(its depth at c, 0) + slack (depth = R - dist(centre, surface)). Why: a pass ends R
+// beyond its section's end at that end's height; where the surface's boundary is oblique to
+// the feed, that centre lies beside neighbouring parts of the surface that stand higher,
+// and rising straight from it the ball would cut into them. Moving away from the nearest
+// surface point first lets it rise clear.
+struct PassEndExit {
+  Vec3 point;          // c itself when rising straight up clears
+  bool proven = false;  // false: none of the candidates cleared; `point` is c
+};
+
+// Above the clear height of a point (x, y), clearHeight(x, y) = (a bound on the surface's
+// height within horizontal distance R of it) + R, every centre is at least R from the surface,
+// so the rise needs proof only below it.
+template <class ClearHeight>
+PassEndExit exitFrom(const SurfaceDistance& distance, Vec3 c, Vec3 outward, double radius,
+                     const ClearHeight& clearHeight, double slack) {
+  // Margins below slack / 64 mean the path creeps along its limit: give up there.
+  const double minStep = slack / 64.0;
+  // nearest.distance is an upper bound: the depth below is at most the true one, so
+  // `allowed` never exceeds max(true depth, 0) + slack.
+  const ClosestPoint nearest = distance.closest(c);
+  const double allowed = std::max(radius - nearest.distance, 0.0) + slack;
+  const double need = radius - allowed;
+  const auto clears = [&](Vec3 from) {
+    const double top = clearHeight(from.x, from.y);
+    return top <= from.z ||
+           segmentClears(distance, from, {from.x, from.y, top}, need, radius, minStep);
+  };
+  if (clears(c)) return {c, true};
+  // Horizontal directions: away from the nearest surface point, along the feed out of the
+  // pass, and between the two.
+  std::vector<Vec3> directions;
+  const auto add = [&](Vec3 v) {
+    const double length = std::hypot(v.x, v.y);
+    if (length > 1e-6 * norm(v)) directions.push_back({v.x / length, v.y / length, 0.0});
+  };
+  const Vec3 away = c - nearest.point;
+  add(away);
+  add(outward);
+  if (directions.size() == 2) add(directions[0] + directions[1]);
+  for (const double multiple : {0.125, 0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0, 4.0}) {
+    for (const Vec3& h : directions) {
+      const Vec3 to = c + (multiple * radius) * h;
+      if (segmentClears(distance, c, to, need, radius, minStep) && clears(to)) return {to, true};
+    }
+  }
+  return {c, false};
+}
+
+// ---------------------------------------------------------------------------------------
 // The best feed angle
 // ---------------------------------------------------------------------------------------
 
@@ -492,6 +579,16 @@ RasterPaths rasterPaths(const Surface& surface, const RasterOptions& options) {
   const PlaneRange range = planeRange(surface, frame.e, out.spacing, "the step-over");
 
   const HeightBound heights(surface, tolerance, 1e-12 * scale);
+  // The ways off (see the contract): limits `slack` above the pass end's depth, proven with
+  // lower bounds good to slack / 8 (tighter ones cost cells and buy nothing).
+  const double slack = std::max(tolerance, radius / 256.0);
+  DistanceOptions loose;
+  loose.tolerance = slack / 8.0;
+  const SurfaceDistance distance(surface, loose);
+  const auto clearHeight = [&](double x, double y) {
+    return heights.above({x, y}, {x, y}, radius) + radius;
+  };
+  const auto line = [](Vec3 end) { return ToolMove{MoveKind::line, end, {}, ArcPlane::xy, true}; };
   for (double kk = range.first; kk <= range.last; kk += 1.0) {
     const double w = kk * out.spacing;
     PlaneSection section = planeSection(surface, frame.e, w, tolerance);
@@ -515,7 +612,25 @@ RasterPaths rasterPaths(const Surface& surface, const RasterOptions& options) {
       out.stats.centreLength += pathLength(chain.hull.toolpath);
       ToolPass pass = passFromHull(chain.hull, frame, w, arcTolerance);
       if (plane.reversed) pass = reversedPass(pass);
-      RasterPass info{index, c, plane.reversed, 0, 0.0};
+      RasterPass info{index, c, plane.reversed, 0, 0.0, 0, 0};
+      // Ways on and off: the entry is an exit run backwards.
+      const Vec3 forward = plane.reversed ? -frame.d : frame.d;
+      const Vec3 cutEnd = passEnd(pass);
+      const PassEndExit entry =
+          exitFrom(distance, pass.start, -forward, radius, clearHeight, slack);
+      const PassEndExit exit = exitFrom(distance, cutEnd, forward, radius, clearHeight, slack);
+      out.unclearedEnds += (entry.proven ? 0 : 1) + (exit.proven ? 0 : 1);
+      if (!(entry.point == pass.start)) {
+        out.linkLength += norm(pass.start - entry.point);
+        pass.moves.insert(pass.moves.begin(), line(pass.start));
+        pass.start = entry.point;
+        info.entryMoves = 1;
+      }
+      if (!(exit.point == cutEnd)) {
+        out.linkLength += norm(exit.point - cutEnd);
+        pass.moves.push_back(line(exit.point));
+        info.exitMoves = 1;
+      }
       // The first pass of a plane after the first is linked from the previous pass's end
       // (which lies at the same end of the surface: zigzag); the rest are retracted.
       if (i == 0 && !out.path.passes.empty()) {
@@ -524,7 +639,6 @@ RasterPaths rasterPaths(const Surface& surface, const RasterOptions& options) {
         const double surfaceTop = heights.above({from.x, from.y}, {to.x, to.y}, radius);
         const double height = std::max({from.z, to.z, surfaceTop + radius});
         std::vector<ToolMove> link;
-        const auto line = [](Vec3 end) { return ToolMove{MoveKind::line, end, {}, ArcPlane::xy, true}; };
         Vec3 at = from;
         for (const Vec3 next : {Vec3{from.x, from.y, height}, Vec3{to.x, to.y, height}, to}) {
           if (next == at) continue;

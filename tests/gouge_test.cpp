@@ -1,8 +1,9 @@
-// Tests for gouge.hpp: the surface distance against references written here (dense sampling
-// with local refinement on random patches; closed forms on a plane; a 1-D minimisation on a
-// parabolic cylinder), its proven bracket and early exit, and the gouge check on paths with
-// known depths (tangent to a plane, dipped into it, over a raised patch on a link, lifted
-// far above the paper's surface #1), with every input error.
+// Tests for gouge.hpp: the surface distance against references written for the tests
+// (dense sampling with local refinement on random patches, distance_reference.hpp; closed
+// forms on a plane; a 1-D minimisation on a parabolic cylinder), its proven bracket and
+// early exit, and the gouge check on paths with known depths (tangent to a plane, dipped
+// into it, over a raised patch on a link, lifted far above the paper's surface #1), with
+// every input error.
 
 #include <gtest/gtest.h>
 
@@ -21,6 +22,7 @@
 #include "scallop/gouge.hpp"
 #include "scallop/surface.hpp"
 #include "scallop/toolpath.hpp"
+#include "distance_reference.hpp"
 
 namespace scallop {
 namespace {
@@ -57,80 +59,8 @@ void expectErrorContaining(const std::function<void()>& run, const std::string& 
   EXPECT_NE(message.find(part), std::string::npos) << "message: " << message;
 }
 
-// ---------------------------------------------------------------------------------------
-// Reference: dense sampling, then a local refinement
-// ---------------------------------------------------------------------------------------
-
-struct Reference {
-  double sampled = std::numeric_limits<double>::infinity();  // least distance on the grid
-  double refined = std::numeric_limits<double>::infinity();  // after the pattern search
-};
-
-double distanceAt(const BezierPatch& patch, Vec3 p, double u, double v) {
-  return norm(point(patch, u, v) - p);
-}
-
-// A compass (pattern) search on [0, 1]^2 from (u, v): try the eight neighbours at step h,
-// move to the best if it improves, else halve h. It needs no derivatives, so it shares
-// nothing with the Newton polish of the code under test; with eight directions every
-// descent direction is within 22.5 degrees of one, so it stops only at a local minimum.
-double patternSearch(const BezierPatch& patch, Vec3 p, double u, double v, double h) {
-  double best = distanceAt(patch, p, u, v);
-  while (h > 1e-13) {
-    double bestU = u;
-    double bestV = v;
-    for (int du = -1; du <= 1; ++du) {
-      for (int dv = -1; dv <= 1; ++dv) {
-        if (du == 0 && dv == 0) continue;
-        const double tu = std::clamp(u + du * h, 0.0, 1.0);
-        const double tv = std::clamp(v + dv * h, 0.0, 1.0);
-        const double d = distanceAt(patch, p, tu, tv);
-        if (d < best) {
-          best = d;
-          bestU = tu;
-          bestV = tv;
-        }
-      }
-    }
-    if (bestU == u && bestV == v) {
-      h *= 0.5;
-    } else {
-      u = bestU;
-      v = bestV;
-    }
-  }
-  return best;
-}
-
-// Every patch sampled on a (grid + 1)^2 grid; the `starts` best grid points of each patch
-// refined by the pattern search.
-Reference referenceDistance(const Surface& surface, Vec3 p, int grid = 32, int starts = 4) {
-  Reference reference;
-  for (const BezierPatch& patch : surface.patches) {
-    struct Sample {
-      double d;
-      double u;
-      double v;
-    };
-    std::vector<Sample> samples;
-    for (int i = 0; i <= grid; ++i) {
-      for (int j = 0; j <= grid; ++j) {
-        const double u = static_cast<double>(i) / grid;
-        const double v = static_cast<double>(j) / grid;
-        samples.push_back({distanceAt(patch, p, u, v), u, v});
-      }
-    }
-    std::partial_sort(samples.begin(), samples.begin() + starts, samples.end(),
-                      [](const Sample& a, const Sample& b) { return a.d < b.d; });
-    reference.sampled = std::min(reference.sampled, samples[0].d);
-    for (int s = 0; s < starts; ++s) {
-      const Sample& start = samples[static_cast<std::size_t>(s)];
-      reference.refined =
-          std::min(reference.refined, patternSearch(patch, p, start.u, start.v, 1.0 / grid));
-    }
-  }
-  return reference;
-}
+using reference::Reference;
+using reference::referenceDistance;
 
 // A graph-like patch over a perturbed grid (x along k, y along j, as the paper's surfaces)
 // with random heights, or (wild) a net of random points: distances need no regularity.

@@ -72,6 +72,7 @@ TEST_F(PathsCli, PlanWithNoArgumentsWritesTheWholeFolder) {
   const auto& stats = report["stats"];
   EXPECT_GT(stats["planes"].get<int>(), 50);
   EXPECT_EQ(stats["passes"].get<std::size_t>(), report["passes"].size());
+  EXPECT_FALSE(stats.contains("link_length"));  // raster only
   // The centre length is the sum of the passes' line lengths.
   double length = 0.0;
   for (const auto& pass : report["passes"]) {
@@ -97,6 +98,9 @@ TEST_F(PathsCli, PlanRasterReportsTheGougeCheck) {
   ASSERT_TRUE(report["gouge"].is_object());
   EXPECT_GE(report["gouge"]["max_depth"].get<double>(), 0.0);
   EXPECT_GE(report["gouge"]["depth_bound"].get<double>(), report["gouge"]["max_depth"].get<double>());
+  // Every pass end of the main job has a proven way off (raster.hpp's Ends).
+  EXPECT_EQ(report["stats"]["uncleared_ends"].get<std::size_t>(), 0u);
+  EXPECT_GT(report["stats"]["link_length"].get<double>(), 0.0);
   EXPECT_TRUE(fs::exists(workDir_ / "r" / "toolpath.gcode"));
   expectPlainNumbers(readFile(workDir_ / "r" / "toolpath.gcode"));
 }

@@ -23,6 +23,7 @@
 #include "scallop/error.hpp"
 #include "scallop/raster.hpp"
 #include "scallop/surface.hpp"
+#include "distance_reference.hpp"
 
 namespace {
 
@@ -289,8 +290,8 @@ Checked checkRaster(const Surface& surface, const RasterPaths& r, double angle, 
       const ToolPass& prev = r.path.passes[i - 1];
       const Vec3 prevEnd = prev.moves.empty() ? prev.start : prev.moves.back().end;
       EXPECT_EQ(pass.start, prevEnd) << where;  // bit for bit
-      const Vec3 cutStart = pass.moves[info.linkMoves - 1].end;
-      const double floor = std::max(prevEnd.z, cutStart.z);
+      const Vec3 linkEnd = pass.moves[info.linkMoves - 1].end;  // the entry point
+      const double floor = std::max(prevEnd.z, linkEnd.z);
       for (std::size_t k = 0; k < info.linkMoves; ++k) {
         const ToolMove& m = pass.moves[k];
         EXPECT_EQ(m.kind, MoveKind::line) << where;
@@ -301,9 +302,9 @@ Checked checkRaster(const Surface& surface, const RasterPaths& r, double angle, 
         EXPECT_TRUE(vertical || m.end.z == at.z) << where << " link move " << k;
         if (vertical) {
           const bool atPrevious = at.x == prevEnd.x && at.y == prevEnd.y;
-          const bool atNext = at.x == cutStart.x && at.y == cutStart.y;
+          const bool atNext = at.x == linkEnd.x && at.y == linkEnd.y;
           EXPECT_TRUE(atPrevious || atNext) << where << " link move " << k;
-          EXPECT_GE(std::min(at.z, m.end.z), atPrevious ? prevEnd.z : cutStart.z)
+          EXPECT_GE(std::min(at.z, m.end.z), atPrevious ? prevEnd.z : linkEnd.z)
               << where << " link move " << k << " goes below its end";
         } else {
           EXPECT_GE(m.end.z, floor) << where << " link move " << k << " goes below the ends";
@@ -323,12 +324,32 @@ Checked checkRaster(const Surface& surface, const RasterPaths& r, double angle, 
       const bool firstOfPlane = i == 0 || r.passes[i - 1].section != info.section;
       EXPECT_TRUE(i == 0 || !firstOfPlane) << where;
     }
+    // The entry and the exit: at most one horizontal line each (their clearance is
+    // PassEndsRiseWithoutCuttingDeeper's business).
+    EXPECT_LE(info.entryMoves, 1u) << where;
+    EXPECT_LE(info.exitMoves, 1u) << where;
+    if (info.entryMoves > 1 || info.exitMoves > 1 ||
+        pass.moves.size() <= info.linkMoves + info.entryMoves + info.exitMoves) {
+      ADD_FAILURE() << where << ": no cutting moves between the entry and the exit";
+      return out;
+    }
+    const auto expectHorizontalLine = [&](Vec3 from, const ToolMove& m, const char* what) {
+      EXPECT_EQ(m.kind, MoveKind::line) << where << " " << what;
+      EXPECT_EQ(m.end.z, from.z) << where << " " << what << " is not horizontal";
+      EXPECT_GT(scallop::norm(m.end - from), 0.0) << where << " " << what << " is empty";
+    };
+    if (info.entryMoves == 1) {
+      expectHorizontalLine(at, pass.moves[info.linkMoves], "entry");
+      at = pass.moves[info.linkMoves].end;
+    }
+    const std::size_t cutEnd = pass.moves.size() - info.exitMoves;
+    if (info.exitMoves == 1) expectHorizontalLine(pass.moves[cutEnd - 1].end, pass.moves.back(), "exit");
 
     // The cutting moves.
     const Vec3 cutStart = at;
     std::vector<Piece> pieces;
     double smin = kInf, smax = -kInf;
-    for (std::size_t k = info.linkMoves; k < pass.moves.size(); ++k) {
+    for (std::size_t k = info.linkMoves + info.entryMoves; k < cutEnd; ++k) {
       const ToolMove& m = pass.moves[k];
       const std::string mw = where + " move " + std::to_string(k);
       Piece piece;
@@ -445,12 +466,90 @@ TEST(Raster, RandomGraphPatchesInchesAndMillimetres) {
       for (const double deg : {0.0, 90.0, 30.0, 137.0}) {
         const double R = 0.25 * unit;
         const RasterPaths r = run(s, deg * kDeg, R, 0.2 * unit);
-        checkRaster(s, r, deg * kDeg, R,
-                    "unit " + std::to_string(unit) + " trial " + std::to_string(trial) + " at " +
-                        std::to_string(deg) + " deg");
+        const std::string label = "unit " + std::to_string(unit) + " trial " +
+                                  std::to_string(trial) + " at " + std::to_string(deg) + " deg";
+        checkRaster(s, r, deg * kDeg, R, label);
+        EXPECT_EQ(r.unclearedEnds, 0u) << label;
       }
     }
   }
+}
+
+// Each pass's ends: from the hull path's end c, the exit (a horizontal move, then straight
+// up to the clear height, the highest control point + R) never brings the ball deeper into
+// the surface than max(its depth at c, 0) + the slack; the entry likewise,
+// backwards. Depths R - dist from the test's own distance reference (dense sampling and a
+// pattern search: it never underestimates a distance, so it never overstates a depth away
+// from c), sampled every R / 10 along the way. At oblique feeds the paper's surfaces have
+// ends where rising straight from c would cut in deeper by far more than the tolerance (the
+// gap the exits close): the test shows they exist, so the check is not vacuous.
+TEST(Raster, PassEndsRiseWithoutCuttingDeeper) {
+  const double R = 0.25;
+  std::size_t straightWouldCutInAll = 0;
+  for (const char* name : {"paper-1", "paper-2"}) {
+    const Surface s = scallop::exampleSurface(name);
+    // The contract's slack: max(chordal tolerance, R / 256).
+    const double slack = std::max(1e-4 * scallop::surfaceScale(s), R / 256.0);
+    double top = -kInf;
+    for (const auto& patch : s.patches)
+      for (const Vec3& p : patch.control) top = std::max(top, p.z);
+    const double clearHeight = top + R;
+    const auto depth = [&](Vec3 c) {
+      return R - scallop::reference::referenceDistance(s, c, 24, 4).refined;
+    };
+    for (const double deg : {30.0, 137.0}) {
+      const std::string label = std::string(name) + " at " + std::to_string(deg) + " deg";
+      const RasterPaths r = run(s, deg * kDeg, R, 0.3);
+      EXPECT_EQ(r.unclearedEnds, 0u) << label;
+      std::size_t moved = 0, straightWouldCut = 0;
+      double worstExcess = -kInf;
+      double offLength = 0.0;  // links, entries and exits
+      // Checks the way off from c through `to` (c itself: straight up); returns how much
+      // deeper than allowed rising straight from c would cut.
+      const auto checkEnd = [&](Vec3 c, Vec3 to, const std::string& where) {
+        const double limit = std::max(depth(c), 0.0) + slack;
+        const auto worstAlong = [&](Vec3 a, Vec3 b) {
+          const int n = std::max(1, static_cast<int>(std::ceil(scallop::norm(b - a) / (R / 10))));
+          double worst = -kInf;
+          for (int k = 1; k <= n; ++k) worst = std::max(worst, depth(a + (b - a) * (double(k) / n)));
+          return worst;
+        };
+        const Vec3 up{to.x, to.y, std::max(clearHeight, to.z)};
+        const double along = std::max(worstAlong(c, to), worstAlong(to, up));
+        worstExcess = std::max(worstExcess, along - limit);
+        EXPECT_LE(along, limit) << label << " " << where << " cuts deeper on its way off";
+        if (to == c) return;
+        ++moved;
+        const double straight = worstAlong(c, {c.x, c.y, std::max(clearHeight, c.z)});
+        if (straight > limit + 0.01) ++straightWouldCut;
+      };
+      for (std::size_t i = 0; i < r.path.passes.size(); ++i) {
+        const ToolPass& pass = r.path.passes[i];
+        const auto& info = r.passes[i];
+        const std::string where = "pass " + std::to_string(i);
+        Vec3 at = pass.start;
+        for (std::size_t k = 0; k < info.linkMoves; ++k) {
+          offLength += scallop::norm(pass.moves[k].end - at);
+          at = pass.moves[k].end;
+        }
+        const Vec3 entry = at;
+        const Vec3 hullStart = info.entryMoves == 1 ? pass.moves[info.linkMoves].end : entry;
+        const std::size_t n = pass.moves.size();
+        const Vec3 exit = pass.moves.back().end;
+        const Vec3 hullEnd = info.exitMoves == 1 ? pass.moves[n - 2].end : exit;
+        offLength += scallop::norm(hullStart - entry) + scallop::norm(exit - hullEnd);
+        checkEnd(hullStart, entry, where + " entry");
+        checkEnd(hullEnd, exit, where + " exit");
+      }
+      EXPECT_NEAR(offLength, r.linkLength, 1e-9 * offLength) << label;
+      EXPECT_GT(moved, 0u) << label;
+      straightWouldCutInAll += straightWouldCut;
+      std::printf("[ raster   ] %s: %zu of %zu ends move away first (%zu where rising straight "
+                  "would cut > 0.01 deeper); worst depth over the limit %.2g\n",
+                  label.c_str(), moved, 2 * r.path.passes.size(), straightWouldCut, worstExcess);
+    }
+  }
+  EXPECT_GT(straightWouldCutInAll, 0u) << "no end where rising straight would cut in";
 }
 
 // Two patches with a gap between them along the feed: one chain per plane when the gap is

@@ -44,6 +44,10 @@ struct PathsReport {
   Vec3 planeNormal;                ///< N of the cutting planes (unit)
   double alphaRad = 0.0;           ///< proven least angle between N and +-n
   std::optional<double> feedAngleRad;   ///< raster: the feed direction's angle from +x
+  /// Raster: the links, entries and exits (RasterPaths::linkLength) and the pass ends with
+  /// no proven way off (RasterPaths::unclearedEnds).
+  std::optional<double> linkLength;
+  std::optional<std::size_t> unclearedEnds;
   PathStats stats;
   std::optional<GougeReport> gouge;  ///< raster: the ball against the whole surface
   double gougeSampleSpacing = 0.0;   ///< the spacing the gouge check sampled at

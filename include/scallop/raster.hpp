@@ -47,22 +47,45 @@
 // Zigzag: planes alternate direction: the j-th plane that cuts (from 0) runs toward
 //         increasing s for even j, decreasing s for odd j (its chains in decreasing s, each
 //         pass reversed: moves in reverse order, arcs' `clockwise` flipped).
-// Links:  the first pass of each plane after the first feeds from the previous pass's end
-//         (retractBefore = false; its `start` is that end): straight up to a link height L,
-//         across at L, straight down to the chain path's start; these leading moves are
-//         counted in RasterPass::linkMoves. L = max(z_end, z_start, Z + R), where Z bounds
-//         the surface's height over every point within horizontal distance R of the across
-//         segment: a ball centre at height >= Z + R there is at least R from each such
-//         point, and at least R horizontally from every other. Z comes from branch and bound
-//         on sub-patches (each within the convex hull of its control points, so under its
-//         box's top) until it is within the chordal tolerance of a surface point in the
-//         region (or after kLinkMaxCells cells, still a bound). The vertical moves are safe
-//         in their planes (the ball is R beyond the chain's end, above its last vertex), but
-//         not beside them: where the surface's boundary is oblique to the feed, the pass's
-//         end lies over neighbouring parts of the surface, and rising from it the ball can
-//         cut into any that stand higher than the end (as a retraction from there would);
-//         gougeCheck (gouge.hpp) measures it with the passes. Further chains of one plane
-//         are entered from the safe height (retractBefore = true), as is the first pass.
+// Ends:   a pass's hull path ends R beyond its chain's end at that end's height. Where the
+//         surface's boundary is oblique to the feed, that centre lies beside neighbouring
+//         parts of the surface that stand higher, and rising straight from it the ball
+//         would cut into them. So each end gets a way off: the exit is the hull path's end
+//         c itself, or one horizontal line move from c to a point c', after which the
+//         centre rises straight to the clear height there, Zc(x, y) = R + a bound on the
+//         surface's height within horizontal distance R of (x, y) (above it every centre is
+//         at least R from the surface; the bound as the links' Z below); the entry is the
+//         same construction at the start, run backwards (from above c' down, then across
+//         to c). Proven (not sampled): along the horizontal move and the rise, the depth
+//         R - dist(centre, surface) never exceeds max(depth at c, 0) + S, the slack
+//         S = max(chordal tolerance, R / 256).
+//         Candidates, first proven wins: straight up from c; then c' = c + t R h for t in
+//         {1/8, 1/4, 1/2, 3/4, 1, 3/2, 2, 3, 4} and h (horizontal, unit) away from the
+//         nearest surface point, along the feed out of the pass, and between the two. The
+//         proof is sphere tracing on gouge.hpp's proven lower bound of the distance (a
+//         1-Lipschitz function; distance tolerance S / 8): from a centre whose bound exceeds
+//         the limit by m, every centre within m is clear. Why S is not just the chordal
+//         tolerance: rising from c, where the ball touches the section's end, the distance
+//         grows only quadratically, and the steps with it; R / 256 halves the steps.
+//         When no candidate is proven (none seen on the paper's surfaces or the tests'
+//         random ones), the end rises straight from c and RasterPaths::unclearedEnds counts
+//         it. The entry and exit moves are in the pass (RasterPass::entryMoves, exitMoves)
+//         and, with the links, in RasterPaths::linkLength.
+// Links:  the first pass of each plane after the first feeds from the previous pass's exit
+//         point (retractBefore = false; its `start` is that point): straight up to a link
+//         height L, across at L, straight down to the pass's entry point; these leading
+//         moves are counted in RasterPass::linkMoves (the entry move follows them).
+//         L = max(z_exit, z_entry, Z + R), where Z bounds the surface's height over every
+//         point within horizontal distance R of the across segment: a ball centre at height
+//         >= Z + R there is at least R from each such point, and at least R horizontally
+//         from every other. Z comes from branch and bound on sub-patches (each within the
+//         convex hull of its control points, so under its box's top) until it is within the
+//         chordal tolerance of a surface point in the region (or after kLinkMaxCells cells,
+//         still a bound). The vertical moves lie within the proven rises, or above Zc where
+//         every centre is clear.
+//         Further chains of one plane are entered from the safe height (retractBefore =
+//         true), as is the first pass: the G-code's retracts and plunges are vertical at
+//         the exit and entry points, proven clear up to Zc and clear above it.
 // Gouging: the offset in the section plane rules out gouging within that plane only; the
 //         ball may still cut into the surface beside the plane where the surface rises
 //         across it. gouge.hpp measures the deepest interference along this path.
@@ -70,7 +93,9 @@
 //         contactLength (section polyline lengths), centreLength (the hull paths' true
 //         lengths, arcs as arcs, links excluded); linkLength separately.
 // Complexity: one planeSection per plane plus O(vertices) per chain for the hull; a link
-//         costs at most kLinkMaxCells sub-patch subdivisions (typically tens).
+//         costs at most kLinkMaxCells sub-patch subdivisions (typically tens); a pass end,
+//         distance queries: tens when rising straight clears, up to a few thousand when
+//         the candidates must be tried.
 //         bestRasterAngle: O(patches * G^2) normals once (G = kAngleGrid + 1), a scan of
 //         kAngleScan angles at O(patches G^2) each, then golden-section refinement.
 
@@ -130,6 +155,10 @@ struct RasterPass {
   bool reversed = false;      ///< runs toward decreasing s
   std::size_t linkMoves = 0;  ///< leading moves that are the link (0 when retracted)
   double linkHeight = 0.0;    ///< L of the link (linkMoves > 0 only)
+  /// Moves after the link that lead from the entry point to the hull path's start (0 or 1).
+  std::size_t entryMoves = 0;
+  /// Trailing moves from the hull path's end to the exit point (0 or 1).
+  std::size_t exitMoves = 0;
 };
 
 struct RasterPaths {
@@ -143,7 +172,11 @@ struct RasterPaths {
   ToolPath path;                        ///< passes in machining order
   std::vector<RasterPass> passes;       ///< parallel to path.passes
   PathStats stats;
-  double linkLength = 0.0;  ///< total length of the link moves
+  /// Total length of the moves that do not follow a hull path: links, entries and exits.
+  double linkLength = 0.0;
+  /// Pass ends (entries and exits) for which no candidate way off was proven clear; each
+  /// rises straight from the hull path's end (see the contract).
+  std::size_t unclearedEnds = 0;
 };
 
 /// The raster paths of `surface` (see the contract). Throws scallop::Error on bad options
