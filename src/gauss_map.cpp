@@ -49,16 +49,25 @@ PatchData makePatchData(const BezierPatch& patch) {
   data.curvature = gaussianCurvatureNumerator(patch);
   data.curvatureU = derivativeU(data.curvature);
   data.curvatureV = derivativeV(data.curvature);
-  // K's numerator is (r_uu . N)(r_vv . N) - (r_uv . N)^2, of the order of |N|^3 |r''|: call it
-  // identically zero when every coefficient is below 1e-12 of that scale.
+  // K's numerator is (r_uu . N)(r_vv . N) - (r_uv . N)^2, of the order of |N|^2 |r''|^2: call
+  // it identically zero when every coefficient is below 1e-12 of that scale. |r''| is taken
+  // at least 1e-6 |r'|: a plane whose control points carry rounding has second derivatives
+  // of rounding size, and so a K of the order of its own scale, yet it is flat (a curved
+  // patch that flat has a Gauss image far below any tolerance, which its boundary's
+  // normals, the image of a developable patch, then cover).
   const Bounds nb = bounds(normalLengthSquared(patch));
   const double nScale = std::sqrt(std::max(std::abs(nb.lo), std::abs(nb.hi)));
+  double first = 0.0;
   double second = 0.0;
-  for (const auto& [du, dv] : {std::pair{2, 0}, std::pair{1, 1}, std::pair{0, 2}}) {
-    for (double u : {0.0, 0.5, 1.0}) {
-      for (double v : {0.0, 0.5, 1.0}) second = std::max(second, norm(secondDerivative(patch, u, v, du, dv)));
+  for (double u : {0.0, 0.5, 1.0}) {
+    for (double v : {0.0, 0.5, 1.0}) {
+      first = std::max({first, norm(derivativeU(patch, u, v)), norm(derivativeV(patch, u, v))});
+      for (const auto& [du, dv] : {std::pair{2, 0}, std::pair{1, 1}, std::pair{0, 2}}) {
+        second = std::max(second, norm(secondDerivative(patch, u, v, du, dv)));
+      }
     }
   }
+  second = std::max(second, 1e-6 * first);
   double largest = 0.0;
   for (double c : data.curvature.coefficients) largest = std::max(largest, std::abs(c));
   data.developable = largest <= 1e-12 * std::max(1e-300, nScale * nScale * second * second);
@@ -187,36 +196,73 @@ bool inOmega(const std::vector<PatchData>& patches, const Vec3& m) {
 }
 
 // ---------------------------------------------------------------------------------------
-// Candidate curves on the sphere.
+// Normal curves, sampled to the tolerance where the polygon is used.
 // ---------------------------------------------------------------------------------------
 
-// Samples the unit normal along a parameter curve c(s), s in [0, 1], refining by halving
-// until the normal at each segment's middle parameter is within `tol` of the normalised
-// chord midpoint (the polygon's deviation from the curve), and no segment spans more than
-// `maxStep` (so that a wiggle between samples is not missed).
-void sampleNormals(const std::function<Vec3(double)>& normalAt, double s0, double s1,
-                   const Vec3& n0, const Vec3& n1, double tol, double maxStep, int depth,
-                   std::vector<Vec3>& out) {
-  const double sm = 0.5 * (s0 + s1);
-  const Vec3 nm = normalAt(sm);
-  const Vec3 chord = n0 + n1;
-  const double chordLength = norm(chord);
-  const bool flat = chordLength > 0.0 && angleBetween(nm, chord / chordLength) <= tol &&
-                    angleBetween(n0, n1) <= maxStep;
-  if (flat || depth >= 40) {
-    out.push_back(n1);
-    return;
-  }
-  sampleNormals(normalAt, s0, sm, n0, nm, tol, maxStep, depth + 1, out);
-  sampleNormals(normalAt, sm, s1, nm, n1, tol, maxStep, depth + 1, out);
-}
+// Samples normal curves n(s), s in [0, 1] (along a cell edge or a patch boundary), by
+// halving until the polygon is within `tol` of the curve and no segment spans more than
+// `maxStep` (so that a wiggle between samples is not missed). The polygon is used as
+// straight segments in the stereographic plane of the pole frame, for n and for -n: a
+// straight segment there is the image of a circle through the pole on the sphere (through
+// the south pole for -n), whose geodesic curvature is the segment's distance h from the
+// origin, so a segment close to the curve on the sphere can still stray from it by about
+// h maxStep^2 / 8 in the plane: degrees at 0.5 degree, where maxStep is 32 degrees (a
+// random two-patch surface lost a 0.9 degree deep sliver of normals that way). So the
+// middle of each planar segment, for both signs, is mapped back onto the sphere and held
+// within `tol` of the curve's point at the middle parameter, as the sphere chord's middle
+// is. The rule depends on the end parameters only (through the normals there and at the
+// middle), so two cells sampling a shared edge agree vertex for vertex.
+struct NormalSampler {
+  double tol;
+  Rotation3 toPoleFrame;
 
-std::vector<Vec3> normalCurve(const std::function<Vec3(double)>& normalAt, double tol) {
-  std::vector<Vec3> out{normalAt(0.0)};
-  const double maxStep = std::max(64.0 * tol, 0.05);
-  sampleNormals(normalAt, 0.0, 1.0, out.front(), normalAt(1.0), tol, maxStep, 0, out);
-  return out;
-}
+  double maxStep() const { return std::max(64.0 * tol, 0.05); }
+
+  // How far (an angle on the sphere) the polygon edge n0-n1 strays from the curve, judged
+  // at the middle: the angle from the curve's middle point nm to the edge's midpoint, on the
+  // sphere and, mapped back onto the sphere, in the plane for n and -n.
+  double deviation(const Vec3& n0, const Vec3& nm, const Vec3& n1) const {
+    const Vec3 chord = n0 + n1;
+    const double chordLength = norm(chord);
+    if (!(chordLength > 0.0)) return std::numbers::pi;
+    double worst = angleBetween(nm, chord / chordLength);
+    for (double sign : {1.0, -1.0}) {
+      const Vec3 r0 = apply(toPoleFrame, sign * n0);
+      const Vec3 r1 = apply(toPoleFrame, sign * n1);
+      // Within 1e-9 of the pole an end has no usable image (the pole itself none at all);
+      // such a piece lies far outside the window the union works in (see clipToSquare's
+      // caller), where only the sphere's measure is kept.
+      auto nearPole = [](const Vec3& r) { return r.z > 0.0 && std::hypot(r.x, r.y) < 1e-9; };
+      if (nearPole(r0) || nearPole(r1)) continue;
+      // The whole angle, not the plane's distance over the local scale: two ends near the
+      // pole on either side of it are joined by a segment through the middle of the plane,
+      // far from the curve, whose middle is near the pole too.
+      const Vec2 middle = 0.5 * (stereographic(r0) + stereographic(r1));
+      worst = std::max(worst, angleBetween(apply(toPoleFrame, sign * nm), inverseStereographic(middle)));
+    }
+    return worst;
+  }
+
+  void refine(const std::function<Vec3(double)>& normalAt, double s0, double s1, const Vec3& n0,
+              const Vec3& n1, int depth, std::vector<Vec3>& out) const {
+    const double sm = 0.5 * (s0 + s1);
+    const Vec3 nm = normalAt(sm);
+    const bool flat = angleBetween(n0, n1) <= maxStep() && deviation(n0, nm, n1) <= tol;
+    if (flat || depth >= 40) {
+      out.push_back(n1);
+      return;
+    }
+    refine(normalAt, s0, sm, n0, nm, depth + 1, out);
+    refine(normalAt, sm, s1, nm, n1, depth + 1, out);
+  }
+
+  // The samples n(0), ..., n(1).
+  std::vector<Vec3> curve(const std::function<Vec3(double)>& normalAt) const {
+    std::vector<Vec3> out{normalAt(0.0)};
+    refine(normalAt, 0.0, 1.0, out.front(), normalAt(1.0), 0, out);
+    return out;
+  }
+};
 
 // ---------------------------------------------------------------------------------------
 // The Gauss image as a union of cell images. A quadtree over each patch stops at cells of
@@ -226,11 +272,10 @@ std::vector<Vec3> normalCurve(const std::function<Vec3(double)>& normalAt, doubl
 //   is the region bounded by the images of the cell's four edges, sampled to the tolerance;
 // - fold cells, across a parabolic line (or too curved), subdivided until their normals
 //   vary by less than the tolerance: the image is the convex hull of sampled normals.
-// Neighbouring cells are widened a little (by about two tolerances of image) so that their
-// polygons overlap rather than leave cracks where the two sides sampled a shared edge
-// differently. The union of the images, and of their antipodes, is Omega; its boundary lies
-// on the images of the patch boundaries and of the parabolic lines (the folds), as the
-// paper's method says, and the polygon union finds it.
+// Neighbouring cells sample a shared edge vertex for vertex (see CellBuilder), so that their
+// polygons meet without cracks. The union of the images, and of their antipodes, is Omega;
+// its boundary lies on the images of the patch boundaries and of the parabolic lines (the
+// folds), as the paper's method says, and the polygon union finds it.
 // ---------------------------------------------------------------------------------------
 
 constexpr double kRegularCellSpread = 0.5;  // radians
@@ -299,15 +344,15 @@ struct CellBuilder {
 
   // Normals along the segment from (ua, va) to (ub, vb) (a piece of a cell edge), without
   // its last point, sampled to the tolerance by halving (deterministic in the end points).
-  void sampleEdge(double ua, double va, double ub, double vb, std::vector<Vec3>& out) const {
-    auto at = [&](double s) { return normalAt(ua + s * (ub - ua), va + s * (vb - va)); };
-    const Vec3 n0 = at(0.0);
-    std::vector<Vec3> piece{n0};
-    sampleNormals(at, 0.0, 1.0, n0, at(1.0), tol, std::max(64.0 * tol, 0.05), 0, piece);
+  void sampleEdge(const NormalSampler& sampler, double ua, double va, double ub, double vb,
+                  std::vector<Vec3>& out) const {
+    const std::vector<Vec3> piece = sampler.curve(
+        [&](double s) { return normalAt(ua + s * (ub - ua), va + s * (vb - va)); });
     out.insert(out.end(), piece.begin(), piece.end() - 1);
   }
 
-  std::vector<CellImage> images() const {
+  // The cells' images, their edges sampled by `sampler` (whose frame is the pole's).
+  std::vector<CellImage> images(const NormalSampler& sampler) const {
     // Corners on every vertical line u = c and horizontal line v = c (dyadic: exact keys).
     std::map<double, std::vector<double>> onU;  // u -> v's of corners
     std::map<double, std::vector<double>> onV;  // v -> u's of corners
@@ -346,15 +391,15 @@ struct CellBuilder {
       // down); each elementary piece sampled in increasing parameter, reversed as needed.
       auto forward = [&](const std::vector<double>& ts, bool alongU, double fixed) {
         for (std::size_t i = 0; i + 1 < ts.size(); ++i) {
-          if (alongU) sampleEdge(ts[i], fixed, ts[i + 1], fixed, loop);
-          else sampleEdge(fixed, ts[i], fixed, ts[i + 1], loop);
+          if (alongU) sampleEdge(sampler, ts[i], fixed, ts[i + 1], fixed, loop);
+          else sampleEdge(sampler, fixed, ts[i], fixed, ts[i + 1], loop);
         }
       };
       auto backward = [&](const std::vector<double>& ts, bool alongU, double fixed) {
         for (std::size_t i = ts.size() - 1; i > 0; --i) {
           std::vector<Vec3> piece;
-          if (alongU) sampleEdge(ts[i - 1], fixed, ts[i], fixed, piece);
-          else sampleEdge(fixed, ts[i - 1], fixed, ts[i], piece);
+          if (alongU) sampleEdge(sampler, ts[i - 1], fixed, ts[i], fixed, piece);
+          else sampleEdge(sampler, fixed, ts[i - 1], fixed, ts[i], piece);
           // piece holds [t_{i-1}, t_i) in increasing order: emit t_i down to t_{i-1}.
           piece.push_back(alongU ? normalAt(ts[i], fixed) : normalAt(fixed, ts[i]));
           for (std::size_t j = piece.size() - 1; j > 0; --j) loop.push_back(piece[j]);
@@ -393,6 +438,92 @@ std::vector<Vec2> convexHull(std::vector<Vec2> points) {
   }
   hull.resize(k - 1);
   return hull;
+}
+
+// The polygon `loop` clipped to the square |x|, |y| <= half (Sutherland-Hodgman, one side
+// at a time): its region meets the square in the region of the result, with the same
+// orientation, plus zero-width bridges along the square's sides. An edge crossing a side is
+// cut at a point computed from its end inside the square (whichever way the edge runs), so
+// two cells sharing an edge cut it at bitwise the same point and still cancel in mergeSheet.
+std::vector<Vec2> clipToSquare(std::vector<Vec2> loop, double half) {
+  // Side k keeps the points with coordinate(k) * direction(k) <= half.
+  for (int side = 0; side < 4 && !loop.empty(); ++side) {
+    const bool alongX = side < 2;
+    const double sense = side % 2 == 0 ? 1.0 : -1.0;
+    auto coordinate = [&](const Vec2& p) { return sense * (alongX ? p.x : p.y); };
+    auto crossing = [&](const Vec2& in, const Vec2& out) {
+      const double t = (half - coordinate(in)) / (coordinate(out) - coordinate(in));
+      Vec2 q = in + t * (out - in);
+      (alongX ? q.x : q.y) = sense * half;  // exactly on the side
+      return q;
+    };
+    std::vector<Vec2> kept;
+    kept.reserve(loop.size() + 4);
+    for (std::size_t i = 0; i < loop.size(); ++i) {
+      const Vec2& a = loop[i == 0 ? loop.size() - 1 : i - 1];
+      const Vec2& b = loop[i];
+      const bool aIn = coordinate(a) <= half;
+      const bool bIn = coordinate(b) <= half;
+      if (aIn != bIn) kept.push_back(aIn ? crossing(a, b) : crossing(b, a));
+      if (bIn) kept.push_back(b);
+    }
+    loop = std::move(kept);
+  }
+  return loop;
+}
+
+// A thin strip of the sphere standing for a piece of a curve image (a developable patch's
+// normals): the points within `halfWidth` of the great-circle arc a-b (a point when b = a),
+// as a loop of sphere points around it, two half circles joined by the arc's offsets. The
+// half circles' polygons are circumscribed (their vertices a little farther out than
+// halfWidth) so that their chords still keep halfWidth. `reach` is the angle from the arc
+// to the loop's vertices, which decides whether the strip holds the pole.
+struct ThinStrip {
+  std::vector<Vec3> loop;
+  double reach = 0.0;
+};
+
+ThinStrip thinStrip(const Vec3& a, const Vec3& b, double halfWidth) {
+  constexpr int kHalf = 8;  // chords per half circle
+  ThinStrip strip;
+  strip.reach = halfWidth / std::cos(std::numbers::pi / (2.0 * kHalf));
+  Vec3 side = cross(a, b);
+  Vec3 ta, tb;  // tangents along the arc: at a towards b, at b away from a
+  if (norm(side) > 1e-12) {
+    side = normalized(side);
+    ta = cross(side, a);
+    tb = cross(side, b);
+  } else {
+    const Vec3 helper = std::abs(a.x) < 0.6 ? Vec3{1.0, 0.0, 0.0} : Vec3{0.0, 1.0, 0.0};
+    side = normalized(cross(a, helper));
+    ta = tb = cross(side, a);
+  }
+  auto around = [&](const Vec3& centre, const Vec3& forward, double phi) {
+    const Vec3 d = std::cos(phi) * forward + std::sin(phi) * side;
+    return normalized(std::cos(strip.reach) * centre + std::sin(strip.reach) * d);
+  };
+  for (int k = 0; k <= kHalf; ++k) {  // around b, from -side through its forward tangent
+    strip.loop.push_back(around(b, tb, -0.5 * std::numbers::pi + std::numbers::pi * k / kHalf));
+  }
+  for (int k = 0; k <= kHalf; ++k) {  // around a, from +side through its backward tangent
+    strip.loop.push_back(around(a, ta, 0.5 * std::numbers::pi + std::numbers::pi * k / kHalf));
+  }
+  return strip;
+}
+
+// The angle from p to the great-circle arc a-b (shorter than a half circle).
+double angleToArc(const Vec3& p, const Vec3& a, const Vec3& b) {
+  const Vec3 side = cross(a, b);
+  const double length = norm(side);
+  if (length > 1e-12) {
+    const Vec3 n = side / length;
+    // p's foot on the arc's great circle lies within the arc when p is ahead of a (along
+    // the arc's tangent n x a there) and behind b (along b x n, its backward tangent).
+    if (dot(cross(n, a), p) >= 0.0 && dot(cross(b, n), p) >= 0.0) {
+      return std::asin(std::min(1.0, std::abs(dot(n, p))));
+    }
+  }
+  return std::min(angleBetween(p, a), angleBetween(p, b));
 }
 
 // Twice the signed area of an integer loop (positive counter-clockwise), in double.
@@ -492,33 +623,65 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
   std::vector<PatchData> patches;
   for (const BezierPatch& p : surface.patches) patches.push_back(makePatchData(p));
 
-  // Cell images of every patch (a developable patch has no regular cell: its image is the
-  // image of its boundary, a curve).
-  std::vector<CellImage> cells;
+  // The cells of every curved patch (a developable patch has no regular cell: its image is
+  // the image of its boundary, a curve).
+  std::vector<CellBuilder> builders;
+  std::vector<const PatchData*> developablePatches;
   int foldCells = 0;
-  bool allDevelopable = true;
-  std::vector<std::vector<Vec3>> developableCurves;
   for (const PatchData& data : patches) {
     if (data.developable) {
-      const BezierPatch& patch = *data.patch;
-      const std::array<std::function<Vec3(double)>, 4> edges{
-          [&](double s) { return unitNormal(patch, s, 0.0); },
-          [&](double s) { return unitNormal(patch, 1.0, s); },
-          [&](double s) { return unitNormal(patch, 1.0 - s, 1.0); },
-          [&](double s) { return unitNormal(patch, 0.0, 1.0 - s); }};
-      for (const auto& edge : edges) developableCurves.push_back(normalCurve(edge, tol));
+      developablePatches.push_back(&data);
       continue;
     }
-    allDevelopable = false;
-    CellBuilder builder{data, tol, {}};
-    builder.run();
-    for (const Cell& c : builder.cells) foldCells += c.fold ? 1 : 0;
-    for (auto& c : builder.images()) cells.push_back(std::move(c));
+    builders.push_back(CellBuilder{data, tol, {}});
+    builders.back().run();
+    for (const Cell& c : builders.back().cells) foldCells += c.fold ? 1 : 0;
   }
   map.parabolicCurves = static_cast<std::size_t>(foldCells);
+  const bool allDevelopable = builders.empty();
+
+  // The pole cell: the regular cell of largest parameter area (the first such, in patch
+  // order); the pole is its centre normal, inside its image, so that image is the outside of
+  // its boundary's projection. It is chosen before any edge is sampled because the sampling
+  // measures the polygon in the pole frame's plane (see NormalSampler). Without a regular
+  // cell the frame's pole is a normal of the first patch.
+  const Vec3 first = unitNormal(surface.patches.front(), 0.5, 0.5);
+  std::size_t poleBuilder = builders.size(), poleIndex = 0;
+  double poleArea = 0.0;
+  for (std::size_t b = 0; b < builders.size(); ++b) {
+    const std::vector<Cell>& list = builders[b].cells;
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const double area = (list[i].u1 - list[i].u0) * (list[i].v1 - list[i].v0);
+      if (!list[i].fold && area > poleArea) poleBuilder = b, poleIndex = i, poleArea = area;
+    }
+  }
+  map.pole = poleBuilder < builders.size() ? builders[poleBuilder].cells[poleIndex].centre : first;
+  map.toPoleFrame = rotationTaking(map.pole, {0.0, 0.0, 1.0});
+  const NormalSampler sampler{tol, map.toPoleFrame};
+
+  // Cell images of every curved patch; the images of the developable patches' boundaries.
+  std::vector<CellImage> cells;
+  std::size_t poleCell = 0;
+  for (std::size_t b = 0; b < builders.size(); ++b) {
+    if (b == poleBuilder) poleCell = cells.size() + poleIndex;
+    for (auto& c : builders[b].images(sampler)) cells.push_back(std::move(c));
+  }
+  // Among curved patches a developable patch's curve is thickened into a strip of half-width
+  // tol / 2 around a polygon sampled to tol / 2 (see thinStrip below): sampled to tol alone,
+  // it is the image itself.
+  const NormalSampler curveSampler{allDevelopable ? tol : 0.5 * tol, map.toPoleFrame};
+  std::vector<std::vector<Vec3>> developableCurves;
+  for (const PatchData* data : developablePatches) {
+    const BezierPatch& patch = *data->patch;
+    const std::array<std::function<Vec3(double)>, 4> edges{
+        [&](double s) { return unitNormal(patch, s, 0.0); },
+        [&](double s) { return unitNormal(patch, 1.0, s); },
+        [&](double s) { return unitNormal(patch, 1.0 - s, 1.0); },
+        [&](double s) { return unitNormal(patch, 0.0, 1.0 - s); }};
+    for (const auto& edge : edges) developableCurves.push_back(curveSampler.curve(edge));
+  }
 
   // All normals within the tolerance of one direction: a plane.
-  const Vec3 first = unitNormal(surface.patches.front(), 0.5, 0.5);
   double spread = 0.0;
   for (const CellImage& c : cells) {
     for (const Vec3& n : c.normals) spread = std::max(spread, angleBetween(first, n));
@@ -535,8 +698,6 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
   }
   if (allDevelopable) {
     map.kind = GaussMapKind::curve;
-    map.pole = first;
-    map.toPoleFrame = rotationTaking(first, {0.0, 0.0, 1.0});
     for (const auto& curve : developableCurves) {
       map.sphereCurves.push_back(curve);
       std::vector<Vec3> opposite;
@@ -545,19 +706,7 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
     }
     return map;
   }
-  // TODO(developable patches among curved ones): their curves are not yet in Omega.
-
-  // The pole cell: the regular cell of largest parameter area; the pole is its centre
-  // normal, inside its image, so that image is the outside of its boundary's projection.
-  std::size_t poleCell = cells.size();
-  for (std::size_t i = 0; i < cells.size(); ++i) {
-    if (!cells[i].fold && (poleCell == cells.size() || cells[i].area > cells[poleCell].area)) {
-      poleCell = i;
-    }
-  }
-  if (poleCell == cells.size()) throw Error("the Gauss map has no regular cell (K = 0 almost everywhere)");
-  map.pole = cells[poleCell].centre;
-  map.toPoleFrame = rotationTaking(map.pole, {0.0, 0.0, 1.0});
+  if (poleBuilder == builders.size()) throw Error("the Gauss map has no regular cell (K = 0 almost everywhere)");
   const Rotation3 back = transpose(map.toPoleFrame);
 
   auto project = [&](const Vec3& n) { return stereographic(apply(map.toPoleFrame, n)); };
@@ -570,14 +719,18 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
   auto toInt = [&](const Vec2& p) {
     return IntPoint(static_cast<int>(std::lround(p.x * scale)), static_cast<int>(std::lround(p.y * scale)));
   };
+  // Everything outside the pole cell's loop is in Omega, so only a cell image's part inside
+  // a square around that loop matters: each polygon is clipped to the square of twice the
+  // loop's extent (coordinates up to 2^30 on the grid). Clipping, unlike moving far
+  // vertices onto the square one by one, keeps the polygon's region and orientation: a cell
+  // whose image comes close to the pole (far out in the plane) but does not hold it would
+  // otherwise be folded over, and mergeSheet, which sums each sheet's cells as oriented
+  // chains, would subtract it from its neighbours' region, leaving a hole in Omega.
+  const double window = 2.0 * extent;
   auto toPolygon = [&](const std::vector<Vec2>& loop) {
     std::vector<IntPoint> points;
-    for (const Vec2& p : loop) {
-      // Images beyond the pole cell's boundary are inside Omega anyway: clamp them there.
-      const Vec2 q = std::abs(p.x) > extent || std::abs(p.y) > extent
-                         ? (extent / std::max(std::abs(p.x), std::abs(p.y))) * p
-                         : p;
-      const IntPoint ip = toInt(q);
+    for (const Vec2& p : clipToSquare(loop, window)) {
+      const IntPoint ip = toInt(p);
       if (points.empty() || !(points.back() == ip)) points.push_back(ip);
     }
     while (points.size() > 1 && points.front() == points.back()) points.pop_back();
@@ -591,6 +744,16 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
   inside.insert(toPolygon(outer));
   IntPolygonSet omega;
   const IntPolygon outerPolygon = toPolygon(outer);
+  // An image that holds the pole is the outside of its projected loop (within the window).
+  const auto insertOutside = [&](const std::vector<Vec2>& loop) {
+    IntPolygonSet ring;
+    ring.insert(outerPolygon);
+    IntPolygonSet cut;
+    cut.insert(toPolygon(loop));
+    IntPolygonSet rest;
+    rest = boost::polygon::operators::operator-(ring, cut);
+    omega.insert(rest);
+  };
   // Regular cells of one patch with one sign of K map with one orientation and share their
   // image vertices exactly with their neighbours (see CellBuilder): their union is the chain
   // left when every edge shared by two of them (traversed once each way) cancels. Handing
@@ -623,13 +786,7 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
         continue;
       }
       if (holdsPole) {
-        IntPolygonSet ring;
-        ring.insert(outerPolygon);
-        IntPolygonSet cut;
-        cut.insert(toPolygon(loop));
-        IntPolygonSet rest;
-        rest = boost::polygon::operators::operator-(ring, cut);
-        omega.insert(rest);
+        insertOutside(loop);
       } else {
         // insert() only collects edges: the union is formed once, by the final difference
         // (operator+= would clean the whole set at every call, quadratic in the cells).
@@ -639,6 +796,38 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
   }
   for (const auto& [unused, polygons] : sheets) {
     for (const auto& [loop, hole] : mergeSheet(polygons)) omega.insert(loop, hole);
+  }
+  // A developable patch among curved ones: its normals form a curve (or a point) that may
+  // lie outside the curved patches' region, and they are obstacles for the slicing
+  // direction like any other normal, so the medial axis must see them. A curve has no
+  // interior for the even-odd loops to bound: it enters Omega as strips of half-width tol / 2
+  // around its polygon, sampled to tol / 2, so that Omega holds the whole curve and its
+  // boundary stays within tol of it.
+  for (const auto& curve : developableCurves) {
+    for (double sign : {1.0, -1.0}) {
+      // Each segment of the polygon (a curve has at least its two ends; a plane's are
+      // equal, and its strip is a disk).
+      const std::size_t segments = std::max<std::size_t>(curve.size(), 2) - 1;
+      for (std::size_t i = 0; i < segments; ++i) {
+        const Vec3 a = sign * curve[i];
+        const Vec3 b = sign * curve[std::min(i + 1, curve.size() - 1)];
+        ThinStrip strip = thinStrip(a, b, 0.5 * tol);
+        // Whether the strip holds the pole, decided with a margin either side of its
+        // polygon's chords (at halfWidth) and vertices (at reach): a strip passing the pole
+        // in between is widened until it clearly holds it.
+        const double gap = angleToArc(map.pole, a, b);
+        if (gap > 0.45 * tol && gap <= 1.01 * strip.reach) strip = thinStrip(a, b, 2.0 * gap);
+        std::vector<Vec2> loop;
+        for (const Vec3& n : strip.loop) loop.push_back(project(n));
+        if (gap <= 1.01 * strip.reach) {
+          // The strip's image is the outside of its projected loop (as for a cell holding
+          // the pole, above).
+          insertOutside(loop);
+        } else {
+          omega.insert(toPolygon(loop));
+        }
+      }
+    }
   }
   IntPolygonSet complement;
   complement = boost::polygon::operators::operator-(inside, omega);

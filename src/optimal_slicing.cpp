@@ -463,7 +463,24 @@ class ContactFinder {
       }
     }
     std::sort(peaks.begin(), peaks.end(), [](const Peak& a, const Peak& b) { return a.value > b.value; });
-    if (peaks.size() > kClimbed) peaks.resize(kClimbed);
+    // Peaks with one normal (to rounding) on one patch are one contact: a developable patch
+    // keeps its normal along each ruling, so its ridge of |n . m| is a line of grid peaks
+    // equal but for rounding (a planar patch, all of it), which would otherwise fill every
+    // slot and leave the other patches' contacts unclimbed.
+    auto normalOf = [&](const Peak& q) {
+      return grids_[q.patch][static_cast<std::size_t>(q.i * (kGrid + 1) + q.j)];
+    };
+    std::vector<Peak> chosen;
+    for (const Peak& peak : peaks) {
+      if (chosen.size() == kClimbed) break;
+      const Vec3 n = normalOf(peak);
+      bool repeated = false;
+      for (const Peak& q : chosen) {
+        repeated = repeated || (q.patch == peak.patch && norm(normalOf(q) - n) < 1e-12);
+      }
+      if (!repeated) chosen.push_back(peak);
+    }
+    peaks = std::move(chosen);
     const std::size_t warmCount = found.size();
     for (const Peak& peak : peaks) {
       const double u = double(peak.i) / kGrid, v = double(peak.j) / kGrid;
@@ -494,7 +511,8 @@ class ContactFinder {
   // ranked by the grid's max |n . N| and more than `separation` apart. The medial axis
   // finds the basin when the Gauss map is right; these catch a map that missed normals (its
   // circle then claims more clearance than the surface has, e.g. 63.0 against a true
-  // optimum of 57.8 degrees on a random two-patch surface) or covers a basin. O(directions
+  // optimum of 57.8 degrees on a random two-patch surface, before the map's union was
+  // fixed) or covers a basin. O(directions
   // x grid points): a few milliseconds per patch.
   std::vector<Vec3> latticeSeeds(int directions, std::size_t count, double separation) const {
     std::vector<std::pair<double, Vec3>> scored;
