@@ -845,16 +845,46 @@ Bernstein2 elevate(const Bernstein2& p, int du, int dv) {
                  [dv](const Coefficients& c) { return elevateCoefficients(c, dv); });
 }
 
+// Both halves of every column (stride `stride` between a column's coefficients, `count`
+// columns `step` apart) in one de Casteljau pass each, with the arithmetic of
+// splitCoefficients (so bitwise its results) and one scratch buffer for all of them: the
+// quadtrees subdivide millions of times.
+namespace {
+void splitLines(const Bernstein2& p, int degree, std::size_t stride, int count, std::size_t step,
+                double t, Bernstein2& left, Bernstein2& right) {
+  const double s = 1.0 - t;
+  const auto n = static_cast<std::size_t>(degree);
+  std::vector<double> b(n + 1);
+  for (int line = 0; line < count; ++line) {
+    const std::size_t base = static_cast<std::size_t>(line) * step;
+    for (std::size_t i = 0; i <= n; ++i) b[i] = p.coefficients[base + i * stride];
+    left.coefficients[base] = b[0];
+    right.coefficients[base + n * stride] = b[n];
+    for (std::size_t r = 1; r <= n; ++r) {
+      for (std::size_t i = 0; i <= n - r; ++i) b[i] = s * b[i] + t * b[i + 1];
+      left.coefficients[base + r * stride] = b[0];
+      right.coefficients[base + (n - r) * stride] = b[n - r];
+    }
+  }
+}
+}  // namespace
+
 std::pair<Bernstein2, Bernstein2> subdivideU(const Bernstein2& p, double t) {
   requireValid(p, "subdivideU");
-  return {mapColumns(p, p.degreeU, [t](const Coefficients& c) { return leftPart(c, t); }),
-          mapColumns(p, p.degreeU, [t](const Coefficients& c) { return rightPart(c, t); })};
+  std::pair<Bernstein2, Bernstein2> out{zero2(p.degreeU, p.degreeV), zero2(p.degreeU, p.degreeV)};
+  // Columns: c_0j .. c_mj, degreeV + 1 apart; column j starts at j.
+  splitLines(p, p.degreeU, static_cast<std::size_t>(p.degreeV + 1), p.degreeV + 1, 1, t,
+             out.first, out.second);
+  return out;
 }
 
 std::pair<Bernstein2, Bernstein2> subdivideV(const Bernstein2& p, double t) {
   requireValid(p, "subdivideV");
-  return {mapRows(p, p.degreeV, [t](const Coefficients& c) { return leftPart(c, t); }),
-          mapRows(p, p.degreeV, [t](const Coefficients& c) { return rightPart(c, t); })};
+  std::pair<Bernstein2, Bernstein2> out{zero2(p.degreeU, p.degreeV), zero2(p.degreeU, p.degreeV)};
+  // Rows: c_i0 .. c_in, contiguous; row i starts at i (degreeV + 1).
+  splitLines(p, p.degreeV, 1, p.degreeU + 1, static_cast<std::size_t>(p.degreeV + 1), t,
+             out.first, out.second);
+  return out;
 }
 
 Bernstein2 restrictTo(const Bernstein2& p, double u0, double u1, double v0, double v1) {

@@ -312,16 +312,25 @@ struct CellBuilder {
 
   Vec3 normalAt(double u, double v) const { return unitNormal(*data.patch, u, v); }
 
-  void run() { visit(data.curvature, 0.0, 1.0, 0.0, 1.0, 0); }
+  // The normals on a cell's 3 x 3 grid of corners, edge midpoints and centre: grid[i][j]
+  // at (u0 + i (u1 - u0) / 2, v0 + j (v1 - v0) / 2). A child cell's corners are points of
+  // its parent's grid (dyadic parameters: bitwise the same), so only five are new.
+  using NormalGrid = std::array<std::array<Vec3, 3>, 3>;
 
-  void visit(const Bernstein2& k, double u0, double u1, double v0, double v1, int depth) {
-    const Vec3 centre = normalAt(0.5 * (u0 + u1), 0.5 * (v0 + v1));
+  void run() {
+    NormalGrid grid;
+    for (int i = 0; i <= 2; ++i) {
+      for (int j = 0; j <= 2; ++j) grid[i][j] = normalAt(0.5 * i, 0.5 * j);
+    }
+    visit(data.curvature, 0.0, 1.0, 0.0, 1.0, 0, grid);
+  }
+
+  void visit(const Bernstein2& k, double u0, double u1, double v0, double v1, int depth,
+             const NormalGrid& grid) {
+    const Vec3& centre = grid[1][1];
     double spread = 0.0;
     for (int i = 0; i <= 2; ++i) {
-      for (int j = 0; j <= 2; ++j) {
-        const Vec3 n = normalAt(u0 + 0.5 * i * (u1 - u0), v0 + 0.5 * j * (v1 - v0));
-        spread = std::max(spread, angleBetween(centre, n));
-      }
+      for (int j = 0; j <= 2; ++j) spread = std::max(spread, angleBetween(centre, grid[i][j]));
     }
     if (strictSign(k) && spread <= kRegularCellSpread) {
       cells.push_back({u0, u1, v0, v1, false, centre, spread, bounds(k).lo > 0.0 ? 1 : -1});
@@ -336,19 +345,32 @@ struct CellBuilder {
     auto [left, right] = subdivideU(k, 0.5);
     auto [ll, lr] = subdivideV(left, 0.5);
     auto [rl, rr] = subdivideV(right, 0.5);
-    visit(ll, u0, um, v0, vm, depth + 1);
-    visit(lr, u0, um, vm, v1, depth + 1);
-    visit(rl, um, u1, v0, vm, depth + 1);
-    visit(rr, um, u1, vm, v1, depth + 1);
+    // The child (a, b): u in [u0 + a (u1 - u0) / 2, ...], v likewise with b.
+    auto child = [&](int a, int b, double cu0, double cu1, double cv0, double cv1) {
+      NormalGrid g;
+      for (int i = 0; i <= 2; ++i) {
+        for (int j = 0; j <= 2; ++j) {
+          if (i % 2 == 0 && j % 2 == 0) {
+            g[i][j] = grid[a + i / 2][b + j / 2];
+          } else {
+            g[i][j] = normalAt(cu0 + 0.5 * i * (cu1 - cu0), cv0 + 0.5 * j * (cv1 - cv0));
+          }
+        }
+      }
+      return g;
+    };
+    visit(ll, u0, um, v0, vm, depth + 1, child(0, 0, u0, um, v0, vm));
+    visit(lr, u0, um, vm, v1, depth + 1, child(0, 1, u0, um, vm, v1));
+    visit(rl, um, u1, v0, vm, depth + 1, child(1, 0, um, u1, v0, vm));
+    visit(rr, um, u1, vm, v1, depth + 1, child(1, 1, um, u1, vm, v1));
   }
 
-  // Normals along the segment from (ua, va) to (ub, vb) (a piece of a cell edge), without
-  // its last point, sampled to the tolerance by halving (deterministic in the end points).
-  void sampleEdge(const NormalSampler& sampler, double ua, double va, double ub, double vb,
-                  std::vector<Vec3>& out) const {
-    const std::vector<Vec3> piece = sampler.curve(
+  // Normals along the segment from (ua, va) to (ub, vb) (a piece of a cell edge), both ends
+  // included, sampled to the tolerance by halving (deterministic in the end points).
+  std::vector<Vec3> sampleEdge(const NormalSampler& sampler, double ua, double va, double ub,
+                               double vb) const {
+    return sampler.curve(
         [&](double s) { return normalAt(ua + s * (ub - ua), va + s * (vb - va)); });
-    out.insert(out.end(), piece.begin(), piece.end() - 1);
   }
 
   // The cells' images, their edges sampled by `sampler` (whose frame is the pole's).
@@ -376,7 +398,9 @@ struct CellBuilder {
       }
       return out;
     };
+    std::map<std::array<double, 3>, std::vector<Vec3>> pieces;
     std::vector<CellImage> out;
+    out.reserve(cells.size());
     for (const Cell& c : cells) {
       CellImage image;
       image.fold = c.fold;
@@ -389,20 +413,32 @@ struct CellBuilder {
       auto& loop = image.normals;
       // Bottom (v = v0, u up), right (u = u1, v up), top (v = v1, u down), left (u = u0, v
       // down); each elementary piece sampled in increasing parameter, reversed as needed.
+      // Each elementary piece is shared by at most two cells (which run it opposite ways):
+      // sampled once, kept until its second use.
+      auto piece = [&](bool alongU, double fixed, double t0, double t1) {
+        const std::array<double, 3> key{alongU ? fixed : -1.0 - fixed, t0, t1};
+        auto it = pieces.find(key);
+        if (it != pieces.end()) {
+          std::vector<Vec3> samples = std::move(it->second);
+          pieces.erase(it);
+          return samples;
+        }
+        std::vector<Vec3> samples = alongU ? sampleEdge(sampler, t0, fixed, t1, fixed)
+                                           : sampleEdge(sampler, fixed, t0, fixed, t1);
+        pieces.emplace(key, samples);
+        return samples;
+      };
       auto forward = [&](const std::vector<double>& ts, bool alongU, double fixed) {
         for (std::size_t i = 0; i + 1 < ts.size(); ++i) {
-          if (alongU) sampleEdge(sampler, ts[i], fixed, ts[i + 1], fixed, loop);
-          else sampleEdge(sampler, fixed, ts[i], fixed, ts[i + 1], loop);
+          const std::vector<Vec3> samples = piece(alongU, fixed, ts[i], ts[i + 1]);
+          loop.insert(loop.end(), samples.begin(), samples.end() - 1);
         }
       };
       auto backward = [&](const std::vector<double>& ts, bool alongU, double fixed) {
         for (std::size_t i = ts.size() - 1; i > 0; --i) {
-          std::vector<Vec3> piece;
-          if (alongU) sampleEdge(sampler, ts[i - 1], fixed, ts[i], fixed, piece);
-          else sampleEdge(sampler, fixed, ts[i - 1], fixed, ts[i], piece);
-          // piece holds [t_{i-1}, t_i) in increasing order: emit t_i down to t_{i-1}.
-          piece.push_back(alongU ? normalAt(ts[i], fixed) : normalAt(fixed, ts[i]));
-          for (std::size_t j = piece.size() - 1; j > 0; --j) loop.push_back(piece[j]);
+          // The piece [t_{i-1}, t_i] in increasing order: emit t_i down to t_{i-1}, exclusive.
+          const std::vector<Vec3> samples = piece(alongU, fixed, ts[i - 1], ts[i]);
+          for (std::size_t j = samples.size() - 1; j > 0; --j) loop.push_back(samples[j]);
         }
       };
       forward(cuts(onV.at(c.v0), c.u0, c.u1), true, c.v0);

@@ -46,8 +46,9 @@
 // Cost:   dominated by the Gauss map. The paper's bicubic surfaces at 0.5 degree: ~50 ms
 //         (paper-1) and ~90 ms (paper-2) of CPU, of which the Gauss map 40 / 85 ms, the
 //         medial axis 9 / 4, eq (13) 1.5 / 1, the polish (8 seeds) 3, the certificate < 1. At
-//         ~100,000 boundary segments (0.0033 / 0.001 degree): ~14 s / ~74 s, the Gauss map
-//         9 s / 69 s, the medial axis 3.4 s / 2.9 s, eq (13) 0.5 s / 0.5 s.
+//         ~100,000 boundary segments (0.0033 / 0.001 degree): ~12 s / ~60 s, the Gauss map
+//         ~8.5 s / ~56 s (two thirds of it Boost's final difference, see gauss_map.hpp), the
+//         medial axis 3.4 s / 2.9 s, eq (13) 0.5 s / 0.5 s.
 // Degenerate surfaces: a plane (Omega two points) gives alpha* = 90 degrees with N* any
 //         direction orthogonal to the normal (one is returned); for a surface whose Gauss
 //         image is a curve (K = 0) the result is found by maximising the minimum angle over
