@@ -279,7 +279,6 @@ struct NormalSampler {
 // ---------------------------------------------------------------------------------------
 
 constexpr double kRegularCellSpread = 0.5;  // radians
-constexpr int kMaxCellDepth = 22;
 
 struct CellImage {
   std::vector<Vec3> normals;  // the images of the cell's boundary, a loop
@@ -308,6 +307,7 @@ struct Cell {
 struct CellBuilder {
   const PatchData& data;
   double tol;
+  int maxDepth;  // GaussMapOptions::maxCellDepth
   std::vector<Cell> cells;
 
   Vec3 normalAt(double u, double v) const { return unitNormal(*data.patch, u, v); }
@@ -336,7 +336,7 @@ struct CellBuilder {
       cells.push_back({u0, u1, v0, v1, false, centre, spread, bounds(k).lo > 0.0 ? 1 : -1});
       return;
     }
-    if (spread <= tol || depth >= kMaxCellDepth) {
+    if (spread <= tol || depth >= maxDepth) {
       cells.push_back({u0, u1, v0, v1, true, centre, spread, 0});
       return;
     }
@@ -654,6 +654,10 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
   if (!(tol > 0.0) || !std::isfinite(tol)) {
     throw Error(fmt::format("the Gauss map tolerance must be a positive angle, got {} rad", tol));
   }
+  if (options.maxCellDepth < 1 || options.maxCellDepth > 40) {
+    throw Error(fmt::format("the Gauss map's deepest quadtree level must be 1 .. 40, got {}",
+                            options.maxCellDepth));
+  }
   if (surface.patches.empty()) throw Error("the surface has no patches");
   GaussMap map;
   std::vector<PatchData> patches;
@@ -669,7 +673,7 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
       developablePatches.push_back(&data);
       continue;
     }
-    builders.push_back(CellBuilder{data, tol, {}});
+    builders.push_back(CellBuilder{data, tol, options.maxCellDepth, {}});
     builders.back().run();
     for (const Cell& c : builders.back().cells) foldCells += c.fold ? 1 : 0;
   }

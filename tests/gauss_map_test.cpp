@@ -280,6 +280,16 @@ TEST(GaussMap, RejectsBadInput) {
     EXPECT_THROW(scallop::symmetrizedGaussMap(s, options), scallop::Error);
   }
   EXPECT_THROW(scallop::symmetrizedGaussMap(Surface{}), scallop::Error);
+  for (int bad : {0, -3, 41}) {
+    scallop::GaussMapOptions options;
+    options.maxCellDepth = bad;
+    try {
+      scallop::symmetrizedGaussMap(s, options);
+      ADD_FAILURE() << "no error for maxCellDepth " << bad;
+    } catch (const scallop::Error& e) {
+      EXPECT_NE(std::string(e.what()).find("got " + std::to_string(bad)), std::string::npos) << e.what();
+    }
+  }
 }
 
 }  // namespace

@@ -65,7 +65,10 @@ namespace scallop {
 
 struct GaussMapOptions {
   double toleranceRad = 0.1 * std::numbers::pi / 180.0;  ///< polygon-to-curve angle, > 0
-  int parabolicMaxDepth = 10;  ///< quadtree depth for the parabolic lines (cells of 2^-depth)
+  /// Deepest quadtree level (cells of 2^-depth in u and v), 1 .. 40: a fold cell stops
+  /// there even if its normals still vary by more than the tolerance (a parabolic line
+  /// where the normal turns faster than 2^depth * tolerance per unit of u or v).
+  int maxCellDepth = 22;
 };
 
 enum class GaussMapKind {
