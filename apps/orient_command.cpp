@@ -24,6 +24,7 @@
 #include "scallop/optimal_slicing.hpp"
 #include "scallop/orient_output.hpp"
 #include "scallop/surface.hpp"
+#include "surface_options.hpp"
 
 namespace scallop::cli {
 namespace {
@@ -40,8 +41,7 @@ constexpr const char* kSphereFigure = "gauss-map.svg";
 constexpr const char* kPlaneFigure = "stereographic.svg";
 
 struct OrientOptions {
-  std::string input;      // SURFACE.json, or "-" for standard input
-  std::string example;    // --example NAME
+  SurfaceSource surface;  // SURFACE.json ("-": standard input) or --example NAME
   std::string tolerance;  // --tolerance DEG, parsed by parseTolerance
   std::string jsonPath;   // --json OUT
   std::string svgDir;     // --svg-dir DIR
@@ -50,7 +50,7 @@ struct OrientOptions {
 
 // Checks the combination of options, which CLI11 cannot express.
 void checkOptions(const OrientOptions& options) {
-  if (options.input.empty() == options.example.empty()) {
+  if (options.surface.input.empty() == options.surface.example.empty()) {
     throw CLI::ValidationError("orient",
                                "give the surface either as SURFACE.json or as --example NAME");
   }
@@ -80,11 +80,6 @@ double parseTolerance(const std::string& text) {
 std::string jsonDestination(const OrientOptions& options) {
   if (!options.jsonPath.empty()) return options.jsonPath;
   return options.svgDir.empty() ? std::string(kStandardStream) : std::string();
-}
-
-std::string sourceName(const OrientOptions& options) {
-  if (!options.example.empty()) return "example " + options.example;
-  return options.input == kStandardStream ? std::string("<stdin>") : options.input;
 }
 
 std::string certificateSummary(const OptimalSlicing& result, bool certify) {
@@ -120,8 +115,7 @@ void runOrient(const OrientOptions& options) {
   }
   slicingOptions.certify = !options.noCertify;
 
-  const Surface surface =
-      options.example.empty() ? readSurface(options.input) : exampleSurface(options.example);
+  const Surface surface = loadSurface(options.surface);
   const OptimalSlicing result = optimalSlicing(surface, slicingOptions);
 
   std::vector<OutputFile> outputs;
@@ -136,7 +130,7 @@ void runOrient(const OrientOptions& options) {
 
   // The summary goes to stderr, but stays quiet when the JSON is piped on standard output.
   if (jsonPath != kStandardStream) {
-    printSummary(sourceName(options), result, slicingOptions.certify, outputs);
+    printSummary(sourceName(options.surface), result, slicingOptions.certify, outputs);
   }
 }
 
@@ -162,16 +156,9 @@ void addOrientCommand(CLI::App& app) {
       "be regular (r_u x r_v != 0).\n"
       "Example: scallop orient --example paper-2 --json out.json --svg-dir figs");
 
-  CLI::Option* file =
-      orient
-          ->add_option("SURFACE", options->input,
-                       "surface file (JSON, Bezier patches); - reads standard input")
-          ->type_name("");
-  CLI::Option* example =
-      orient->add_option("--example", options->example, "use a built-in example surface instead")
-          ->check(CLI::IsMember(exampleSurfaceNames()))
-          ->type_name("NAME");
-  file->excludes(example);
+  addSurfaceSourceOptions(*orient, options->surface,
+                          "surface file (JSON, Bezier patches); - reads standard input",
+                          "use a built-in example surface instead");
   orient
       ->add_option("--tolerance", options->tolerance,
                    fmt::format("angular tolerance of the Gauss map's polygonal boundary, in "

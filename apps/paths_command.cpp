@@ -19,6 +19,7 @@
 #include "scallop/gcode.hpp"
 #include "scallop/paths_output.hpp"
 #include "scallop/surface.hpp"
+#include "surface_options.hpp"
 #include "toolpath_job.hpp"
 
 namespace scallop::cli {
@@ -27,8 +28,7 @@ namespace {
 constexpr const char* kStandardStream = "-";
 
 struct PathsOptions {
-  std::string input;
-  std::string example;
+  SurfaceSource surface;
   std::string toolRadius;
   std::string spacing;
   std::string scallopHeight;
@@ -43,7 +43,7 @@ struct PathsOptions {
 };
 
 void runPaths(const PathsOptions& options) {
-  if (options.input.empty() == options.example.empty())
+  if (options.surface.input.empty() == options.surface.example.empty())
     throw CLI::ValidationError("paths", "give the surface either as SURFACE.json or as --example NAME");
   if (options.spacing.empty() == options.scallopHeight.empty())
     throw CLI::ValidationError("paths", "give exactly one of --spacing and --scallop-height");
@@ -62,9 +62,8 @@ void runPaths(const PathsOptions& options) {
   if (!options.angle.empty()) job.angleDeg = parseFinite(options.angle, "angle", "degrees");
   job.gougeCheck = !options.noGougeCheck;
 
-  const Surface surface =
-      options.example.empty() ? readSurface(options.input) : exampleSurface(options.example);
-  const std::string source = options.example.empty() ? options.input : "example " + options.example;
+  const Surface surface = loadSurface(options.surface);
+  const std::string source = sourceName(options.surface);
   const JobResult result = runToolpathJob(surface, source, job, std::nullopt, {});
 
   std::vector<OutputFile> outputs;
@@ -72,7 +71,7 @@ void runPaths(const PathsOptions& options) {
   const std::string jsonPath = anyOutput ? options.jsonPath : std::string(kStandardStream);
   if (!jsonPath.empty()) outputs.push_back({jsonPath, pathsToJson(result.report, result.path)});
   if (!options.gcodePath.empty()) {
-    const GcodeDialect dialect = options.dialect == "grbl" ? GcodeDialect::grbl : GcodeDialect::linuxcnc;
+    const GcodeDialect dialect = gcodeDialect(options.dialect);
     const std::string title = fmt::format("scallop paths {} {}", options.strategy, source);
     outputs.push_back({options.gcodePath,
                        gcodeProgram(result.path, defaultGcodeOptions(surface, result.path, dialect, title))});
@@ -110,28 +109,20 @@ void addPathsCommand(CLI::App& app) {
       "the planes and the surface: Delta = 2 sqrt(2 R H - H^2) sin(alpha).\n"
       "Example: scallop paths --example paper-1 --tool-radius 0.25 --scallop-height 0.001 "
       "--gcode out.ngc --svg out.svg");
-  CLI::Option* file = paths->add_option("SURFACE", options->input, "surface file (JSON); - reads standard input")
-                          ->type_name("");
-  CLI::Option* example = paths->add_option("--example", options->example, "use a built-in example surface")
-                             ->check(CLI::IsMember(exampleSurfaceNames()))
-                             ->type_name("NAME");
-  file->excludes(example);
+  addSurfaceSourceOptions(*paths, options->surface, "surface file (JSON); - reads standard input",
+                          "use a built-in example surface");
   paths->add_option("--tool-radius", options->toolRadius, "ball radius R, in the surface's units")
       ->required()
       ->type_name("R");
   paths->add_option("--spacing", options->spacing, "distance Delta between the planes")->type_name("D");
   paths->add_option("--scallop-height", options->scallopHeight, "largest scallop height H (< R)")
       ->type_name("H");
-  paths->add_option("--strategy", options->strategy, "contour (default) or raster")
-      ->check(CLI::IsMember({"contour", "raster"}))
-      ->type_name("NAME");
+  addStrategyOption(*paths, options->strategy);
   paths->add_option("--normal", options->normal, "contour: auto (the optimal N*, default) or X,Y,Z")
       ->type_name("auto|X,Y,Z");
   paths->add_option("--angle", options->angle, "raster: feed direction in degrees from +x (default: the best)")
       ->type_name("DEG");
-  paths->add_option("--dialect", options->dialect, "G-code dialect: linuxcnc (default) or grbl")
-      ->check(CLI::IsMember({"linuxcnc", "grbl"}))
-      ->type_name("NAME");
+  addDialectOption(*paths, options->dialect);
   paths->add_option("--json", options->jsonPath, "write the report and the passes as JSON (- = standard output)")
       ->type_name("OUT");
   paths->add_option("--gcode", options->gcodePath, "write the G-code program")->type_name("OUT");

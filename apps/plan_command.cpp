@@ -29,6 +29,7 @@
 #include "scallop/orient_output.hpp"
 #include "scallop/paths_output.hpp"
 #include "scallop/surface.hpp"
+#include "surface_options.hpp"
 #include "toolpath_job.hpp"
 
 namespace scallop::cli {
@@ -37,8 +38,7 @@ namespace {
 namespace fs = std::filesystem;
 
 struct PlanOptions {
-  std::string input;
-  std::string example;
+  SurfaceSource surface;
   std::string strategy = "contour";
   std::string toolRadius;
   std::string scallopHeight;
@@ -49,14 +49,12 @@ struct PlanOptions {
 };
 
 void runPlan(const PlanOptions& options) {
-  if (!options.input.empty() && !options.example.empty())
-    throw CLI::ValidationError("plan", "give the surface either as SURFACE.json or as --example NAME");
   if (!options.spacing.empty() && !options.scallopHeight.empty())
     throw CLI::ValidationError("plan", "give at most one of --spacing and --scallop-height");
-  const std::string exampleName =
-      options.input.empty() ? (options.example.empty() ? "paper-1" : options.example) : "";
-  const Surface surface = exampleName.empty() ? readSurface(options.input) : exampleSurface(exampleName);
-  const std::string source = exampleName.empty() ? options.input : "example " + exampleName;
+  SurfaceSource from = options.surface;
+  if (from.input.empty() && from.example.empty()) from.example = "paper-1";  // the main job
+  const Surface surface = loadSurface(from);
+  const std::string source = sourceName(from);
   const bool inch = surface.units == Units::inch;
   auto progress = [&](const std::string& line) {
     if (!options.quiet) fmt::print(stderr, "scallop plan: {}...\n", line);
@@ -84,7 +82,7 @@ void runPlan(const PlanOptions& options) {
                                           orientation.gaussMap.boundarySegments, orientation.seconds};
 
   progress("writing G-code, report and figures");
-  const GcodeDialect dialect = options.dialect == "grbl" ? GcodeDialect::grbl : GcodeDialect::linuxcnc;
+  const GcodeDialect dialect = gcodeDialect(options.dialect);
   const std::string title = fmt::format("scallop plan {} {}", options.strategy, source);
   const fs::path dir = options.out;
   const std::string figureTitle = fmt::format(
@@ -125,15 +123,9 @@ void addPlanCommand(CLI::App& app) {
       "scallop height, the contour strategy on the optimal planes N*; writes toolpath.ngc, "
       "report.json, paths.svg, paths-plan.svg, gauss-map.svg and stereographic.svg into "
       "scallop-out/ (or --out DIR), all or nothing.");
-  CLI::Option* file = plan->add_option("SURFACE", options->input, "surface file (JSON); - reads standard input")
-                          ->type_name("");
-  CLI::Option* example = plan->add_option("--example", options->example, "a built-in example (default paper-1)")
-                             ->check(CLI::IsMember(exampleSurfaceNames()))
-                             ->type_name("NAME");
-  file->excludes(example);
-  plan->add_option("--strategy", options->strategy, "contour (default) or raster")
-      ->check(CLI::IsMember({"contour", "raster"}))
-      ->type_name("NAME");
+  addSurfaceSourceOptions(*plan, options->surface, "surface file (JSON); - reads standard input",
+                          "a built-in example (default paper-1)");
+  addStrategyOption(*plan, options->strategy);
   plan->add_option("--tool-radius", options->toolRadius, "ball radius R (default 0.25 in or 6 mm)")
       ->type_name("R");
   plan->add_option("--scallop-height", options->scallopHeight,
@@ -141,9 +133,7 @@ void addPlanCommand(CLI::App& app) {
       ->type_name("H");
   plan->add_option("--spacing", options->spacing, "plane spacing Delta instead of a scallop height")
       ->type_name("D");
-  plan->add_option("--dialect", options->dialect, "G-code dialect: linuxcnc (default) or grbl")
-      ->check(CLI::IsMember({"linuxcnc", "grbl"}))
-      ->type_name("NAME");
+  addDialectOption(*plan, options->dialect);
   plan->add_option("--out", options->out, "output folder (default scallop-out)")->type_name("DIR");
   plan->add_flag("--quiet", options->quiet, "no progress lines");
   plan->callback([options] { runPlan(*options); });

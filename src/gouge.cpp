@@ -589,32 +589,6 @@ ClosestPoint search(const Surface& surface, const std::vector<PatchTree>& trees,
 // Tool-path sampling
 // ---------------------------------------------------------------------------------------
 
-// (e1, e2, normal) coordinates of an arc plane, right-handed, so that counter-clockwise seen
-// from the normal's positive end is increasing atan2(e2, e1): G17 (x, y, z), G18 (z, x, y),
-// G19 (y, z, x).
-Vec3 toPlane(ArcPlane plane, Vec3 a) {
-  switch (plane) {
-    case ArcPlane::xy:
-      return {a.x, a.y, a.z};
-    case ArcPlane::zx:
-      return {a.z, a.x, a.y};
-    case ArcPlane::yz:
-      return {a.y, a.z, a.x};
-  }
-  return a;
-}
-Vec3 fromPlane(ArcPlane plane, Vec3 a) {
-  switch (plane) {
-    case ArcPlane::xy:
-      return {a.x, a.y, a.z};
-    case ArcPlane::zx:
-      return {a.y, a.z, a.x};
-    case ArcPlane::yz:
-      return {a.z, a.x, a.y};
-  }
-  return a;
-}
-
 // One stretch of the path to sample: a line or an arc from `from` to `to`.
 struct Segment {
   std::size_t pass = 0;
@@ -644,7 +618,7 @@ Vec3 positionOn(const Segment& s, std::size_t i) {
   if (s.kind == MoveKind::line) return s.from + t * (s.to - s.from);
   const double angle = s.angle0 + t * s.sweep;
   const double radius = s.radius0 + t * (s.radius1 - s.radius0);
-  return fromPlane(s.plane,
+  return fromArcPlane(s.plane,
                    {s.center.x + radius * std::cos(angle), s.center.y + radius * std::sin(angle),
                     s.height0 + t * (s.height1 - s.height0)});
 }
@@ -664,9 +638,9 @@ Segment arcSegment(Segment s, const ToolMove& move) {
   const std::string name = where(s.pass, s.move, false);
   requireFinite(move.center, name + ".center");
   s.plane = move.plane;
-  const Vec3 a = toPlane(move.plane, s.from);
-  const Vec3 b = toPlane(move.plane, s.to);
-  s.center = toPlane(move.plane, move.center);
+  const Vec3 a = toArcPlane(move.plane, s.from);
+  const Vec3 b = toArcPlane(move.plane, s.to);
+  s.center = toArcPlane(move.plane, move.center);
   s.radius0 = std::hypot(a.x - s.center.x, a.y - s.center.y);
   s.radius1 = std::hypot(b.x - s.center.x, b.y - s.center.y);
   const double radius = std::max(s.radius0, s.radius1);

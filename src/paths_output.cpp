@@ -46,21 +46,12 @@ Json moveJson(const ToolMove& move) {
   return json;
 }
 
-// The two in-plane axes (a, b) of an arc plane, ordered so that a x b is the plane's positive
-// normal: xy -> (x, y), zx -> (z, x), yz -> (y, z).
-void planeAxes(ArcPlane plane, Vec3& a, Vec3& b) {
-  switch (plane) {
-    case ArcPlane::xy: a = {1, 0, 0}, b = {0, 1, 0}; return;
-    case ArcPlane::zx: a = {0, 0, 1}, b = {1, 0, 0}; return;
-    case ArcPlane::yz: a = {0, 1, 0}, b = {0, 0, 1}; return;
-  }
-}
-
 // Points along an arc move from `from`, for drawing: counter-clockwise in (a, b) is positive
 // angle; clockwise (G2) is negative.
 void appendArc(const Vec3& from, const ToolMove& move, std::vector<Vec3>& out) {
-  Vec3 a, b;
-  planeAxes(move.plane, a, b);
+  // The plane's in-plane axes, a x b its positive normal (toolpath.hpp).
+  const Vec3 a = fromArcPlane(move.plane, {1.0, 0.0, 0.0});
+  const Vec3 b = fromArcPlane(move.plane, {0.0, 1.0, 0.0});
   const Vec3 s = from - move.center, e = move.end - move.center;
   const double a0 = std::atan2(dot(s, b), dot(s, a));
   double sweep = std::atan2(dot(e, b), dot(e, a)) - a0;

@@ -43,6 +43,32 @@ struct ToolMove {
   bool clockwise = true;          ///< arc only: G2 when true, G3 when false
 };
 
+/// Coordinates (e1, e2, n) of a point in an arc plane's frame, right-handed, so that
+/// counter-clockwise seen from the normal's positive end is increasing atan2(e2, e1):
+/// G17 (x, y, z), G18 (z, x, y), G19 (y, z, x). fromArcPlane is the inverse.
+constexpr Vec3 toArcPlane(ArcPlane plane, Vec3 a) {
+  switch (plane) {
+    case ArcPlane::xy:
+      return {a.x, a.y, a.z};
+    case ArcPlane::zx:
+      return {a.z, a.x, a.y};
+    case ArcPlane::yz:
+      return {a.y, a.z, a.x};
+  }
+  return a;
+}
+constexpr Vec3 fromArcPlane(ArcPlane plane, Vec3 a) {
+  switch (plane) {
+    case ArcPlane::xy:
+      return {a.x, a.y, a.z};
+    case ArcPlane::zx:
+      return {a.y, a.z, a.x};
+    case ArcPlane::yz:
+      return {a.z, a.x, a.y};
+  }
+  return a;
+}
+
 struct ToolPass {
   Vec3 start;                   ///< tool centre where the pass begins
   std::vector<ToolMove> moves;  ///< each from the previous end (or `start`) to its `end`

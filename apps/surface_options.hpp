@@ -1,0 +1,40 @@
+#pragma once
+// Command-line pieces that `orient`, `paths` and `plan` share: where the surface comes from
+// (a JSON file, standard input or a built-in example) and, for the tool-path commands, the
+// strategy and the G-code dialect.
+
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "scallop/gcode.hpp"
+#include "scallop/surface.hpp"
+
+namespace scallop::cli {
+
+/// SURFACE (a path, "-" for standard input) or --example NAME; at most one is set.
+struct SurfaceSource {
+  std::string input;
+  std::string example;
+};
+
+/// Adds the SURFACE positional and --example NAME (checked against the built-in names,
+/// mutually exclusive) to `command`.
+void addSurfaceSourceOptions(CLI::App& command, SurfaceSource& source, const std::string& fileHelp,
+                             const std::string& exampleHelp);
+
+/// The surface: the example if named, else the file (scallop::Error naming the file on bad
+/// input).
+Surface loadSurface(const SurfaceSource& source);
+
+/// How messages and reports name the surface: "example NAME", "<stdin>" or the path.
+std::string sourceName(const SurfaceSource& source);
+
+/// --strategy contour|raster and --dialect linuxcnc|grbl, into `strategy` and `dialect`.
+void addStrategyOption(CLI::App& command, std::string& strategy);
+void addDialectOption(CLI::App& command, std::string& dialect);
+
+/// The dialect named by --dialect (already checked by the option).
+GcodeDialect gcodeDialect(const std::string& name);
+
+}  // namespace scallop::cli
