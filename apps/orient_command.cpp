@@ -65,13 +65,18 @@ double defaultToleranceDeg() {
   return std::round(toDegrees(OptimalSlicingOptions{}.toleranceRad) * 1e9) / 1e9;
 }
 
-// Degrees in (0, kMaxToleranceDeg).
+// Degrees in [the Gauss map's least tolerance, kMaxToleranceDeg).
 double parseTolerance(const std::string& text) {
   const double degrees =
       parsePositive(text, "tolerance", "a positive angle in degrees, below 5");
   if (!(degrees < kMaxToleranceDeg)) {
     throw Error(fmt::format("invalid tolerance '{}': must be below {} degrees", text,
                             kMaxToleranceDeg));
+  }
+  const double leastDeg = toDegrees(kMinGaussMapToleranceRad);
+  if (degrees < leastDeg) {
+    throw Error(fmt::format("invalid tolerance '{}': must be at least {:.2g} degrees (finer than "
+                            "the Gauss map's integer grid resolves)", text, leastDeg));
   }
   return degrees;
 }

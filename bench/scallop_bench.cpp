@@ -96,9 +96,10 @@ void BM_BruteForceEnvelope(benchmark::State& state) {
 //   BM_Orient/<surface>               at the default tolerance (0.5 degree, a few hundred
 //                                     boundary segments)
 //   BM_OrientFine/<surface>_100k      at the tolerance that gives ~100,000 Gauss-map boundary
-//                                     segments (issue item 7; one iteration, tens of seconds,
-//                                     nearly all of it in the Gauss map); counters: segments,
-//                                     alpha_deg
+//                                     segments (issue item 7: 5e-7 degree on both surfaces;
+//                                     one iteration, about ten seconds); counters: segments,
+//                                     alpha_deg; BM_GaussMap and BM_OrientMedialAxis at the
+//                                     same tolerance for its breakdown
 // and its stages alone, at the default tolerance, for the breakdown (the polish and eq 13 are
 // BM_OrientNoCertificate less BM_GaussMap less BM_OrientMedialAxis):
 //   BM_GaussMap/<surface>             the symmetrized Gauss map
@@ -155,19 +156,22 @@ void BM_OrientCertificate(benchmark::State& state, const char* name) {
   state.counters["cells"] = static_cast<double>(cells);
 }
 
-void BM_GaussMap(benchmark::State& state, const char* name) {
+void BM_GaussMap(benchmark::State& state, const char* name, double toleranceDeg) {
   const scallop::Surface surface = scallop::exampleSurface(name);
   scallop::GaussMapOptions options;
-  options.toleranceRad = scallop::OptimalSlicingOptions{}.toleranceRad;
+  options.toleranceRad = toleranceDeg * kDegree;
+  std::size_t segments = 0;
   for (auto _ : state) {
     scallop::GaussMap map = scallop::symmetrizedGaussMap(surface, options);
-    benchmark::DoNotOptimize(map.boundarySegments);
+    segments = map.boundarySegments;
+    benchmark::DoNotOptimize(segments);
   }
+  state.counters["segments"] = static_cast<double>(segments);
 }
 
-void BM_OrientMedialAxis(benchmark::State& state, const char* name) {
+void BM_OrientMedialAxis(benchmark::State& state, const char* name, double toleranceDeg) {
   scallop::GaussMapOptions options;
-  options.toleranceRad = scallop::OptimalSlicingOptions{}.toleranceRad;
+  options.toleranceRad = toleranceDeg * kDegree;
   scallop::PlanarDomain domain;
   domain.loops = scallop::symmetrizedGaussMap(scallop::exampleSurface(name), options).loops;
   for (auto _ : state) {
@@ -205,18 +209,22 @@ void BM_MedialAxis(benchmark::State& state) {
 
 BENCHMARK_CAPTURE(BM_Orient, paper1, "paper-1")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Orient, paper2, "paper-2")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_GaussMap, paper1, "paper-1")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_GaussMap, paper2, "paper-2")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_OrientMedialAxis, paper1, "paper-1")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_OrientMedialAxis, paper2, "paper-2")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_GaussMap, paper1, "paper-1", 0.5)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_GaussMap, paper2, "paper-2", 0.5)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_OrientMedialAxis, paper1, "paper-1", 0.5)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_OrientMedialAxis, paper2, "paper-2", 0.5)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_OrientNoCertificate, paper1, "paper-1")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_OrientNoCertificate, paper2, "paper-2")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_OrientCertificate, paper1, "paper-1")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_OrientCertificate, paper2, "paper-2")->Unit(benchmark::kMillisecond);
-// The tolerances that give ~100,000 boundary segments: 103,494 on paper-1 at 0.0033 degree,
-// 95,127 on paper-2 at 0.001 (its count jumps to 151,711 at 0.0009).
-BENCHMARK_CAPTURE(BM_OrientFine, paper1_100k, "paper-1", 0.0033)->Iterations(1)->Unit(benchmark::kSecond);
-BENCHMARK_CAPTURE(BM_OrientFine, paper2_100k, "paper-2", 0.001)->Iterations(1)->Unit(benchmark::kSecond);
+// The tolerance that gives ~100,000 boundary segments: 5e-7 degree, 103,797 segments on
+// paper-1 and 109,479 on paper-2 (the count grows as the tolerance's inverse square root).
+BENCHMARK_CAPTURE(BM_OrientFine, paper1_100k, "paper-1", 5e-7)->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(BM_OrientFine, paper2_100k, "paper-2", 5e-7)->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(BM_GaussMap, paper1_100k, "paper-1", 5e-7)->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(BM_GaussMap, paper2_100k, "paper-2", 5e-7)->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(BM_OrientMedialAxis, paper1_100k, "paper-1", 5e-7)->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(BM_OrientMedialAxis, paper2_100k, "paper-2", 5e-7)->Iterations(1)->Unit(benchmark::kSecond);
 BENCHMARK(BM_MedialAxis)->Arg(1000)->Arg(10000)->Arg(100000)->Unit(benchmark::kMillisecond);
 
 BENCHMARK(BM_ScallopHull)->RangeMultiplier(2)->Range(1 << 10, 1 << 23)->Unit(benchmark::kMillisecond);

@@ -1,5 +1,5 @@
-// The symmetrized Gauss map: candidate curves (patch boundaries and parabolic lines), their
-// cutting at intersections, and the selection of the true boundary by membership tests.
+// The symmetrized Gauss map: a quadtree of regular, traced and small fold cells over each
+// patch, their images (edges and traced parabolic arcs) merged into sheets, and the union.
 // See include/scallop/gauss_map.hpp for the contract.
 
 #include "scallop/gauss_map.hpp"
@@ -10,6 +10,7 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <set>
 #include <tuple>
 #include <unordered_map>
 #include <fmt/format.h>
@@ -244,34 +245,41 @@ struct NormalSampler {
   }
 
   void refine(const std::function<Vec3(double)>& normalAt, double s0, double s1, const Vec3& n0,
-              const Vec3& n1, int depth, std::vector<Vec3>& out) const {
+              const Vec3& n1, int depth, std::vector<Vec3>& out,
+              std::vector<double>* parameters) const {
     const double sm = 0.5 * (s0 + s1);
     const Vec3 nm = normalAt(sm);
     const bool flat = angleBetween(n0, n1) <= maxStep() && deviation(n0, nm, n1) <= tol;
     if (flat || depth >= 40) {
       out.push_back(n1);
+      if (parameters != nullptr) parameters->push_back(s1);
       return;
     }
-    refine(normalAt, s0, sm, n0, nm, depth + 1, out);
-    refine(normalAt, sm, s1, nm, n1, depth + 1, out);
+    refine(normalAt, s0, sm, n0, nm, depth + 1, out, parameters);
+    refine(normalAt, sm, s1, nm, n1, depth + 1, out, parameters);
   }
 
-  // The samples n(0), ..., n(1).
-  std::vector<Vec3> curve(const std::function<Vec3(double)>& normalAt) const {
+  // The samples n(0), ..., n(1); their parameters s in `parameters` when given.
+  std::vector<Vec3> curve(const std::function<Vec3(double)>& normalAt,
+                          std::vector<double>* parameters = nullptr) const {
     std::vector<Vec3> out{normalAt(0.0)};
-    refine(normalAt, 0.0, 1.0, out.front(), normalAt(1.0), 0, out);
+    if (parameters != nullptr) parameters->assign(1, 0.0);
+    refine(normalAt, 0.0, 1.0, out.front(), normalAt(1.0), 0, out, parameters);
     return out;
   }
 };
 
 // ---------------------------------------------------------------------------------------
 // The Gauss image as a union of cell images. A quadtree over each patch stops at cells of
-// two kinds:
+// three kinds:
 // - regular cells, where the curvature numerator keeps a strict sign (so the Gauss map is
 //   a local diffeomorphism) and the normals vary by less than kRegularCellSpread: the image
 //   is the region bounded by the images of the cell's four edges, sampled to the tolerance;
-// - fold cells, across a parabolic line (or too curved), subdivided until their normals
-//   vary by less than the tolerance: the image is the convex hull of sampled normals.
+// - traced cells (traceAxis), crossed by one arc of a parabolic line that is a graph over
+//   u or v: split along the traced arc into their K > 0 and K < 0 parts, each bounded by
+//   its edges' images and the arc's (the fold's) image;
+// - small fold cells, subdivided until their normals vary by less than the tolerance:
+//   split along the chord between two crossings, else the convex hull of their normals.
 // Neighbouring cells sample a shared edge vertex for vertex (see CellBuilder), so that their
 // polygons meet without cracks. The union of the images, and of their antipodes, is Omega;
 // its boundary lies on the images of the patch boundaries and of the parabolic lines (the
@@ -280,9 +288,20 @@ struct NormalSampler {
 
 constexpr double kRegularCellSpread = 0.5;  // radians
 
+// A part of a cell where K keeps one sign: the image of its boundary, a loop (the image
+// is the region it bounds, with the orientation of that sign).
+struct SheetPart {
+  std::vector<Vec3> normals;
+  int curvatureSign = 0;
+};
+
 struct CellImage {
   std::vector<Vec3> normals;  // the images of the cell's boundary, a loop
-  bool fold = false;          // a fold cell: take the hull of `normals`
+  bool fold = false;          // a fold cell (see CellBuilder::split)
+  /// The cell's parts for the sheets: the whole cell for a regular cell, and for a fold
+  /// cell its two sides of the parabolic line (or the whole cell where K keeps one sign on
+  /// its boundary); empty when a fold cell takes the hull of `normals` instead.
+  std::vector<SheetPart> parts;
   Vec3 centre;                // the normal at the cell's centre
   double spread = 0.0;        // largest angle from `centre` to a normal of the cell (sampled)
   double area = 0.0;          // parameter area, to pick the pole cell
@@ -297,7 +316,49 @@ struct Cell {
   Vec3 centre;
   double spread;
   int curvatureSign;  // regular cells: the sign of K on the cell
+  // Fold cells whose parabolic line is traced (see traceAxis): 1 when K's zero set is a
+  // graph v(u) on the cell, 2 when it is a graph u(v); 0 for the small fold cells.
+  int traceAxis = 0;
 };
+
+// Whether the parabolic line crosses the cell (K's Bernstein coefficients `k` over it) as a
+// single arc that can be traced as a graph: 1 when every coefficient difference along v has
+// one strict sign (K is strictly monotone in v, so for each u at most one root: K's zero set
+// is a union of graphs v(u), and no closed loop, which would have a point where K_v = 0)
+// and the edges v = v0 and v = v1 show at most one sign variation each (at most one root
+// each: the u where the graph exists, {K(u, v0) and K(u, v1) of opposite signs}, is then
+// one interval, so there is one arc, or none); 2 likewise with u and v exchanged; else 0.
+int traceAxis(const Bernstein2& k) {
+  const int m = k.degreeU, n = k.degreeV;
+  auto monotone = [&](bool alongV) {
+    int sign = 0;
+    for (int i = 0; i <= m - (alongV ? 0 : 1); ++i) {
+      for (int j = 0; j <= n - (alongV ? 1 : 0); ++j) {
+        const double d = alongV ? k.at(i, j + 1) - k.at(i, j) : k.at(i + 1, j) - k.at(i, j);
+        const int s = d > 0.0 ? 1 : (d < 0.0 ? -1 : 0);
+        if (s == 0 || (sign != 0 && s != sign)) return false;
+        sign = s;
+      }
+    }
+    return sign != 0;
+  };
+  auto edgeVariations = [&](bool alongU, int fixed) {
+    Bernstein1 edge;
+    if (alongU) {
+      for (int i = 0; i <= m; ++i) edge.coefficients.push_back(k.at(i, fixed));
+    } else {
+      for (int j = 0; j <= n; ++j) edge.coefficients.push_back(k.at(fixed, j));
+    }
+    return signVariations(edge);
+  };
+  if (n >= 1 && monotone(true) && edgeVariations(true, 0) <= 1 && edgeVariations(true, n) <= 1) {
+    return 1;
+  }
+  if (m >= 1 && monotone(false) && edgeVariations(false, 0) <= 1 && edgeVariations(false, m) <= 1) {
+    return 2;
+  }
+  return 0;
+}
 
 // Cells of one patch, and the images of their boundaries. Every cell edge is cut at every
 // cell corner that lies on it (the quadtree's T-junctions), and each elementary piece is
@@ -309,6 +370,24 @@ struct CellBuilder {
   double tol;
   int maxDepth;  // GaussMapOptions::maxCellDepth
   std::vector<Cell> cells;
+  // A direction (and its antipode) no traced cell may hold: the pole, whose image is far out
+  // in the plane (see symmetrizedGaussMap); such a cell is subdivided instead.
+  const Vec3* avoid = nullptr;
+  // Cells not to trace (their edges did not show two crossings in an earlier run).
+  std::set<std::array<double, 4>> noTrace;
+
+  // Whether the cell may have the normal +-m: decided exactly in Bernstein form where its
+  // sampled normals come within twice their spread of it.
+  bool mayHold(double u0, double u1, double v0, double v1, const Vec3& centre, double spread,
+               const Vec3& m) const {
+    for (double sign : {1.0, -1.0}) {
+      if (angleBetween(centre, sign * m) > 2.0 * spread + tol) continue;
+      std::array<Bernstein2, 3> local;
+      for (std::size_t i = 0; i < 3; ++i) local[i] = restrictTo(data.normal[i], u0, u1, v0, v1);
+      if (hasNormal(local, sign * m)) return true;
+    }
+    return false;
+  }
 
   Vec3 normalAt(double u, double v) const { return unitNormal(*data.patch, u, v); }
 
@@ -335,6 +414,14 @@ struct CellBuilder {
     if (strictSign(k) && spread <= kRegularCellSpread) {
       cells.push_back({u0, u1, v0, v1, false, centre, spread, bounds(k).lo > 0.0 ? 1 : -1});
       return;
+    }
+    if (spread <= kRegularCellSpread) {
+      const int axis = traceAxis(k);
+      if (axis != 0 && !(avoid != nullptr && mayHold(u0, u1, v0, v1, centre, spread, *avoid)) &&
+          !noTrace.contains({u0, u1, v0, v1})) {
+        cells.push_back({u0, u1, v0, v1, true, centre, spread, 0, axis});
+        return;
+      }
     }
     if (spread <= tol || depth >= maxDepth) {
       cells.push_back({u0, u1, v0, v1, true, centre, spread, 0});
@@ -368,13 +455,214 @@ struct CellBuilder {
   // Normals along the segment from (ua, va) to (ub, vb) (a piece of a cell edge), both ends
   // included, sampled to the tolerance by halving (deterministic in the end points).
   std::vector<Vec3> sampleEdge(const NormalSampler& sampler, double ua, double va, double ub,
-                               double vb) const {
+                               double vb, std::vector<double>* parameters = nullptr) const {
     return sampler.curve(
-        [&](double s) { return normalAt(ua + s * (ub - ua), va + s * (vb - va)); });
+        [&](double s) { return normalAt(ua + s * (ub - ua), va + s * (vb - va)); }, parameters);
   }
 
+  // The Gaussian curvature numerator (r_uu . N)(r_vv . N) - (r_uv . N)^2 at (u, v), from the
+  // patch's derivatives: the polynomial `data.curvature`, evaluated cheaply.
+  double curvatureAt(double u, double v) const {
+    const BezierPatch& p = *data.patch;
+    const Vec3 n = normalVector(p, u, v);
+    const double l = dot(secondDerivative(p, u, v, 2, 0), n);
+    const double m = dot(secondDerivative(p, u, v, 1, 1), n);
+    const double nn = dot(secondDerivative(p, u, v, 0, 2), n);
+    return l * nn - m * m;
+  }
+
+  // The root of K on the segment from p0 to p1, where K has opposite signs f0 and f1 at the
+  // ends, as the parameter s in (0, 1): the Illinois variant of regula falsi (superlinear,
+  // and bracketed; the segments are short where this runs).
+  double curvatureRoot(UV p0, UV p1, double f0, double f1) const {
+    auto at = [&](double s) { return curvatureAt(p0.u + s * (p1.u - p0.u), p0.v + s * (p1.v - p0.v)); };
+    double s0 = 0.0, s1 = 1.0;
+    double root = 0.5;
+    int side = 0;
+    for (int it = 0; it < 100 && s1 - s0 > 1e-15; ++it) {
+      root = (s0 * f1 - s1 * f0) / (f1 - f0);
+      if (!(root > s0 && root < s1)) root = 0.5 * (s0 + s1);
+      const double f = at(root);
+      if (f == 0.0) break;
+      if ((f < 0.0) == (f0 < 0.0)) {
+        s0 = root, f0 = f;
+        if (side == -1) f1 *= 0.5;
+        side = -1;
+      } else {
+        s1 = root, f1 = f;
+        if (side == 1) f0 *= 0.5;
+        side = 1;
+      }
+    }
+    return root;
+  }
+
+  // Samples of a cell-edge piece with the sign of K at each and their parameters, and the
+  // points where the piece crosses a parabolic line (sign 0) inserted between samples of
+  // opposite sign.
+  struct EdgeSamples {
+    std::vector<Vec3> normals;
+    std::vector<signed char> signs;
+    std::vector<UV> where;
+  };
+
+  // The piece from a to b. A regular cell's K has a strict sign on its closed cell, so a
+  // piece it asks for takes that sign (`knownSign`) without evaluation; a fold cell's piece
+  // (knownSign 0) is evaluated. Either way the result depends on the piece alone, so the
+  // two cells sharing it agree. One crossing is found between two samples of opposite
+  // sign: a traced cell's edges have at most one root each (see traceAxis), and a small
+  // fold cell's edges are shorter than the tolerance.
+  EdgeSamples sampleEdgeWithSigns(const NormalSampler& sampler, UV a, UV b, int knownSign) const {
+    EdgeSamples out;
+    std::vector<double> parameters;
+    const std::vector<Vec3> normals = sampleEdge(sampler, a.u, a.v, b.u, b.v, &parameters);
+    auto pointAt = [&](double s) { return UV{a.u + s * (b.u - a.u), a.v + s * (b.v - a.v)}; };
+    if (knownSign != 0) {
+      out.normals = normals;
+      out.signs.assign(normals.size(), static_cast<signed char>(knownSign));
+      for (double s : parameters) out.where.push_back(pointAt(s));
+      return out;
+    }
+    std::vector<double> values(parameters.size());
+    for (std::size_t i = 0; i < parameters.size(); ++i) {
+      const UV p = pointAt(parameters[i]);
+      values[i] = curvatureAt(p.u, p.v);
+    }
+    auto signOf = [](double k) -> signed char { return k > 0.0 ? 1 : (k < 0.0 ? -1 : 0); };
+    for (std::size_t i = 0; i < parameters.size(); ++i) {
+      if (i > 0 && values[i - 1] * values[i] < 0.0) {
+        const UV p0 = pointAt(parameters[i - 1]), p1 = pointAt(parameters[i]);
+        const double t = curvatureRoot(p0, p1, values[i - 1], values[i]);
+        const UV root{p0.u + t * (p1.u - p0.u), p0.v + t * (p1.v - p0.v)};
+        out.normals.push_back(normalAt(root.u, root.v));
+        out.signs.push_back(0);
+        out.where.push_back(root);
+      }
+      out.normals.push_back(normals[i]);
+      out.signs.push_back(signOf(values[i]));
+      out.where.push_back(pointAt(parameters[i]));
+    }
+    return out;
+  }
+
+  // The normals along the parabolic line of a traced cell from its crossing a to its
+  // crossing b (both included, bitwise those of the edges), sampled to the tolerance: the
+  // line is the graph v(u) (traceAxis 1) or u(v) (2), each point the one root of K on the
+  // cell's chord across at that u (or v).
+  std::vector<Vec3> traceParabolicLine(const Cell& c, UV a, UV b, const NormalSampler& sampler) const {
+    const bool graphOfU = c.traceAxis == 1;
+    const double from = graphOfU ? a.u : a.v, to = graphOfU ? b.u : b.v;
+    if (from == to) return {normalAt(a.u, a.v), normalAt(b.u, b.v)};
+    auto pointAt = [&](double s) -> UV {
+      if (s == 0.0) return a;
+      if (s == 1.0) return b;
+      const double t = from + s * (to - from);
+      const UV lo = graphOfU ? UV{t, c.v0} : UV{c.u0, t};
+      const UV hi = graphOfU ? UV{t, c.v1} : UV{c.u1, t};
+      const double f0 = curvatureAt(lo.u, lo.v), f1 = curvatureAt(hi.u, hi.v);
+      double r = 0.0;
+      if (f0 * f1 < 0.0) {
+        r = curvatureRoot(lo, hi, f0, f1);
+      } else {
+        r = std::abs(f0) <= std::abs(f1) ? 0.0 : 1.0;  // rounding at the arc's ends
+      }
+      return {lo.u + r * (hi.u - lo.u), lo.v + r * (hi.v - lo.v)};
+    };
+    return sampler.curve([&](double s) {
+      const UV p = pointAt(s);
+      return normalAt(p.u, p.v);
+    });
+  }
+
+  // A fold cell's boundary loop (normals with the sign of K at each, 0 on a parabolic line,
+  // and their parameters) split into the parts where K keeps one sign: with no crossing and
+  // one sign throughout, the whole cell; with two crossings, the two sides, each closed by
+  // the parabolic line between the crossings: traced (traceAxis), or for a small fold cell
+  // (whose normals vary by less than the tolerance) the chord. Anything else (several
+  // lines, K = 0 along an edge): no parts, and the cell takes the hull of its normals.
+  // `crossings` receives the two crossings of a split cell.
+  std::vector<SheetPart> split(const Cell& c, const NormalSampler& sampler,
+                               const std::vector<Vec3>& loop, const std::vector<signed char>& signs,
+                               const std::vector<UV>& where, std::pair<UV, UV>* crossings) const {
+    std::vector<std::size_t> zeros;
+    for (std::size_t i = 0; i < signs.size(); ++i) {
+      if (signs[i] == 0) zeros.push_back(i);
+    }
+    auto uniform = [&](std::size_t from, std::size_t count) -> int {
+      // The sign shared by `count` samples from `from` on (cyclically), or 0.
+      if (count == 0) return 0;
+      const int first = signs[from % signs.size()];
+      for (std::size_t k = 1; k < count; ++k) {
+        if (signs[(from + k) % signs.size()] != first) return 0;
+      }
+      return first;
+    };
+    if (zeros.empty()) {
+      const int sign = uniform(0, signs.size());
+      if (sign == 0) return {};
+      return {SheetPart{loop, sign}};
+    }
+    if (zeros.size() != 2) return {};
+    const std::size_t a = zeros[0], b = zeros[1], n = loop.size();
+    const int first = uniform(a + 1, b - a - 1);
+    const int second = uniform(b + 1, n - (b - a) - 1);
+    if (first == 0 || second == 0 || first == second) return {};
+    // The line from a to b, ends included (for a small fold cell, the chord: its ends).
+    const std::vector<Vec3> line = c.traceAxis != 0
+                                       ? traceParabolicLine(c, where[a], where[b], sampler)
+                                       : std::vector<Vec3>{loop[a], loop[b]};
+    std::vector<SheetPart> parts(2);
+    for (std::size_t k = a; k <= b; ++k) parts[0].normals.push_back(loop[k]);
+    for (std::size_t k = line.size() - 2; k >= 1; --k) parts[0].normals.push_back(line[k]);
+    for (std::size_t k = b; k <= a + n; ++k) parts[1].normals.push_back(loop[k % n]);
+    for (std::size_t k = 1; k + 1 < line.size(); ++k) parts[1].normals.push_back(line[k]);
+    parts[0].curvatureSign = first;
+    parts[1].curvatureSign = second;
+    if (crossings != nullptr) *crossings = {where[a], where[b]};
+    return parts;
+  }
+
+  struct ImageStats {
+    std::size_t parabolicLines = 0;  // connected pieces of parabolic line (chains of arcs)
+    std::size_t tracedCells = 0;     // fold cells whose line was traced
+    std::size_t untracedCells = 0;   // traced cells whose edges did not show two crossings
+  };
+
+  // The number of connected chains among parabolic-line arcs given by their end points
+  // (arcs of neighbouring cells meet at bitwise the same crossing).
+  static std::size_t chainCount(const std::vector<std::pair<UV, UV>>& arcs) {
+    std::map<std::pair<double, double>, std::size_t> ids;
+    std::vector<std::size_t> parent;
+    auto id = [&](const UV& p) {
+      auto [it, inserted] = ids.emplace(std::pair{p.u, p.v}, parent.size());
+      if (inserted) parent.push_back(parent.size());
+      return it->second;
+    };
+    auto find = [&](std::size_t x) {
+      while (parent[x] != x) x = parent[x] = parent[parent[x]];
+      return x;
+    };
+    std::size_t components = 0;
+    for (const auto& [a, b] : arcs) {
+      const std::size_t ia = id(a);
+      const std::size_t ib = id(b);
+      const std::size_t ra = find(ia), rb = find(ib);
+      if (ra != rb) parent[ra] = rb;
+    }
+    for (std::size_t x = 0; x < parent.size(); ++x) components += find(x) == x ? 1 : 0;
+    return components;
+  }
+
+  using CellBounds = std::array<double, 4>;
+  static CellBounds boundsOf(const Cell& c) { return {c.u0, c.u1, c.v0, c.v1}; }
+
   // The cells' images, their edges sampled by `sampler` (whose frame is the pole's).
-  std::vector<CellImage> images(const NormalSampler& sampler) const {
+  // `untraceable` receives the traced cells whose edges did not show their arc's two ends
+  // (rounding at a crossing), to be subdivided in a new run.
+  std::vector<CellImage> images(const NormalSampler& sampler, ImageStats& stats,
+                                std::vector<CellBounds>& untraceable) const {
+    std::vector<std::pair<UV, UV>> arcs;
+    for (const Cell& c : cells) stats.tracedCells += c.traceAxis != 0 ? 1 : 0;
     // Corners on every vertical line u = c and horizontal line v = c (dyadic: exact keys).
     std::map<double, std::vector<double>> onU;  // u -> v's of corners
     std::map<double, std::vector<double>> onV;  // v -> u's of corners
@@ -398,7 +686,7 @@ struct CellBuilder {
       }
       return out;
     };
-    std::map<std::array<double, 3>, std::vector<Vec3>> pieces;
+    std::map<std::array<double, 3>, EdgeSamples> pieces;
     std::vector<CellImage> out;
     out.reserve(cells.size());
     for (const Cell& c : cells) {
@@ -411,6 +699,8 @@ struct CellBuilder {
       image.curvatureSign = c.curvatureSign;
       image.u0 = c.u0, image.u1 = c.u1, image.v0 = c.v0, image.v1 = c.v1;
       auto& loop = image.normals;
+      std::vector<signed char> signs;
+      std::vector<UV> where;
       // Bottom (v = v0, u up), right (u = u1, v up), top (v = v1, u down), left (u = u0, v
       // down); each elementary piece sampled in increasing parameter, reversed as needed.
       // Each elementary piece is shared by at most two cells (which run it opposite ways):
@@ -419,34 +709,53 @@ struct CellBuilder {
         const std::array<double, 3> key{alongU ? fixed : -1.0 - fixed, t0, t1};
         auto it = pieces.find(key);
         if (it != pieces.end()) {
-          std::vector<Vec3> samples = std::move(it->second);
+          EdgeSamples samples = std::move(it->second);
           pieces.erase(it);
           return samples;
         }
-        std::vector<Vec3> samples = alongU ? sampleEdge(sampler, t0, fixed, t1, fixed)
-                                           : sampleEdge(sampler, fixed, t0, fixed, t1);
+        EdgeSamples samples =
+            alongU ? sampleEdgeWithSigns(sampler, {t0, fixed}, {t1, fixed}, c.curvatureSign)
+                   : sampleEdgeWithSigns(sampler, {fixed, t0}, {fixed, t1}, c.curvatureSign);
         pieces.emplace(key, samples);
         return samples;
       };
       auto forward = [&](const std::vector<double>& ts, bool alongU, double fixed) {
         for (std::size_t i = 0; i + 1 < ts.size(); ++i) {
-          const std::vector<Vec3> samples = piece(alongU, fixed, ts[i], ts[i + 1]);
-          loop.insert(loop.end(), samples.begin(), samples.end() - 1);
+          const EdgeSamples samples = piece(alongU, fixed, ts[i], ts[i + 1]);
+          loop.insert(loop.end(), samples.normals.begin(), samples.normals.end() - 1);
+          signs.insert(signs.end(), samples.signs.begin(), samples.signs.end() - 1);
+          where.insert(where.end(), samples.where.begin(), samples.where.end() - 1);
         }
       };
       auto backward = [&](const std::vector<double>& ts, bool alongU, double fixed) {
         for (std::size_t i = ts.size() - 1; i > 0; --i) {
           // The piece [t_{i-1}, t_i] in increasing order: emit t_i down to t_{i-1}, exclusive.
-          const std::vector<Vec3> samples = piece(alongU, fixed, ts[i - 1], ts[i]);
-          for (std::size_t j = samples.size() - 1; j > 0; --j) loop.push_back(samples[j]);
+          const EdgeSamples samples = piece(alongU, fixed, ts[i - 1], ts[i]);
+          for (std::size_t j = samples.normals.size() - 1; j > 0; --j) {
+            loop.push_back(samples.normals[j]);
+            signs.push_back(samples.signs[j]);
+            where.push_back(samples.where[j]);
+          }
         }
       };
       forward(cuts(onV.at(c.v0), c.u0, c.u1), true, c.v0);
       forward(cuts(onU.at(c.u1), c.v0, c.v1), false, c.u1);
       backward(cuts(onV.at(c.v1), c.u0, c.u1), true, c.v1);
       backward(cuts(onU.at(c.u0), c.v0, c.v1), false, c.u0);
+      if (c.fold) {
+        std::pair<UV, UV> crossing;
+        image.parts = split(c, sampler, loop, signs, where, &crossing);
+        if (image.parts.size() == 2) arcs.emplace_back(crossing.first, crossing.second);
+        if (image.parts.empty() && c.traceAxis != 0) {
+          ++stats.untracedCells;
+          untraceable.push_back(boundsOf(c));
+        }
+      } else {
+        image.parts = {SheetPart{loop, c.curvatureSign}};
+      }
       out.push_back(std::move(image));
     }
+    stats.parabolicLines += chainCount(arcs);
     return out;
   }
 };
@@ -574,9 +883,17 @@ double signedArea2(const std::vector<IntPoint>& loop) {
 }
 
 // The union of one sheet's cell polygons (all of one orientation, sharing vertices exactly):
-// the directed edges left after each edge met in both directions cancels, walked into loops;
-// each loop with its flag "hole" (orientation opposite to the cells').
-std::vector<std::pair<IntPolygon, bool>> mergeSheet(const std::vector<IntPolygon>& cells) {
+// the directed edges left after each edge met in both directions cancels, walked into loops.
+// The loops are to be inserted with the sheet's orientation (`counterClockwise`) as their
+// winding, so that each edge counts by its own direction: where the walk joins pieces of
+// opposite sense at a vertex (a hole touching the outline), the loop's parts still add
+// and subtract as the cells did.
+struct MergedSheet {
+  std::vector<std::vector<IntPoint>> loops;
+  bool counterClockwise = true;
+};
+
+MergedSheet mergeSheet(const std::vector<IntPolygon>& cells) {
   struct Key {
     long long ax, ay, bx, by;
     bool operator==(const Key&) const = default;
@@ -615,7 +932,8 @@ std::vector<std::pair<IntPolygon, bool>> mergeSheet(const std::vector<IntPolygon
           IntPoint(static_cast<int>(k.bx), static_cast<int>(k.by)));
     }
   }
-  std::vector<std::pair<IntPolygon, bool>> out;
+  MergedSheet out;
+  out.counterClockwise = orientation > 0.0;
   for (auto& [start, targets] : next) {
     while (!targets.empty()) {
       std::vector<IntPoint> loop;
@@ -632,10 +950,7 @@ std::vector<std::pair<IntPolygon, bool>> mergeSheet(const std::vector<IntPolygon
         if (id(from) == start) break;
       }
       if (loop.size() < 3) continue;
-      IntPolygon polygon;
-      polygon.set(loop.begin(), loop.end());
-      const bool hole = (signedArea2(loop) > 0.0) != (orientation > 0.0);
-      out.push_back({std::move(polygon), hole});
+      out.loops.push_back(std::move(loop));
     }
   }
   return out;
@@ -654,6 +969,11 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
   if (!(tol > 0.0) || !std::isfinite(tol)) {
     throw Error(fmt::format("the Gauss map tolerance must be a positive angle, got {} rad", tol));
   }
+  if (tol < kMinGaussMapToleranceRad) {
+    throw Error(fmt::format("the Gauss map tolerance {} rad is finer than its integer grid "
+                            "resolves; the least is {} rad ({} degree)",
+                            tol, kMinGaussMapToleranceRad, kMinGaussMapToleranceRad * 180.0 / std::numbers::pi));
+  }
   if (options.maxCellDepth < 1 || options.maxCellDepth > 40) {
     throw Error(fmt::format("the Gauss map's deepest quadtree level must be 1 .. 40, got {}",
                             options.maxCellDepth));
@@ -667,17 +987,14 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
   // the image of its boundary, a curve).
   std::vector<CellBuilder> builders;
   std::vector<const PatchData*> developablePatches;
-  int foldCells = 0;
   for (const PatchData& data : patches) {
     if (data.developable) {
       developablePatches.push_back(&data);
       continue;
     }
-    builders.push_back(CellBuilder{data, tol, options.maxCellDepth, {}});
+    builders.push_back(CellBuilder{data, tol, options.maxCellDepth, {}, nullptr, {}});
     builders.back().run();
-    for (const Cell& c : builders.back().cells) foldCells += c.fold ? 1 : 0;
   }
-  map.parabolicCurves = static_cast<std::size_t>(foldCells);
   const bool allDevelopable = builders.empty();
 
   // The pole cell: the regular cell of largest parameter area (the first such, in patch
@@ -697,14 +1014,50 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
   }
   map.pole = poleBuilder < builders.size() ? builders[poleBuilder].cells[poleIndex].centre : first;
   map.toPoleFrame = rotationTaking(map.pole, {0.0, 0.0, 1.0});
+
   const NormalSampler sampler{tol, map.toPoleFrame};
 
   // Cell images of every curved patch; the images of the developable patches' boundaries.
+  // A patch is run again, with cells subdivided instead of traced, while some traced cell
+  // holds +-pole (its part would be the outside of its loop, as for the cells handled by
+  // insertOutside below, for which only a small cell's hull can stand) or whose edges did not
+  // show two crossings. Regular cells come out the same, the pole cell among them.
   std::vector<CellImage> cells;
   std::size_t poleCell = 0;
+  CellBuilder::ImageStats imageStats;
+  std::size_t foldCells = 0;
   for (std::size_t b = 0; b < builders.size(); ++b) {
-    if (b == poleBuilder) poleCell = cells.size() + poleIndex;
-    for (auto& c : builders[b].images(sampler)) cells.push_back(std::move(c));
+    CellBuilder& builder = builders[b];
+    const CellBuilder::CellBounds poleBounds =
+        b == poleBuilder ? CellBuilder::boundsOf(builder.cells[poleIndex]) : CellBuilder::CellBounds{};
+    builder.avoid = &map.pole;
+    bool rerun = std::any_of(builder.cells.begin(), builder.cells.end(), [&](const Cell& c) {
+      return c.traceAxis != 0 && builder.mayHold(c.u0, c.u1, c.v0, c.v1, c.centre, c.spread, map.pole);
+    });
+    std::vector<CellImage> images;
+    CellBuilder::ImageStats stats;
+    for (int run = 0; run < 64; ++run) {
+      if (rerun) {
+        builder.cells.clear();
+        builder.run();
+      }
+      std::vector<CellBuilder::CellBounds> untraceable;
+      stats = {};
+      images = builder.images(sampler, stats, untraceable);
+      if (untraceable.empty()) break;
+      builder.noTrace.insert(untraceable.begin(), untraceable.end());
+      rerun = true;
+    }
+    if (b == poleBuilder) {
+      for (std::size_t i = 0; i < builder.cells.size(); ++i) {
+        if (!builder.cells[i].fold && CellBuilder::boundsOf(builder.cells[i]) == poleBounds) poleCell = cells.size() + i;
+      }
+    }
+    imageStats.parabolicLines += stats.parabolicLines;
+    imageStats.tracedCells += stats.tracedCells;
+    imageStats.untracedCells += stats.untracedCells;
+    for (const Cell& c : builder.cells) foldCells += c.fold && c.traceAxis == 0 ? 1 : 0;
+    for (auto& c : images) cells.push_back(std::move(c));
   }
   // Among curved patches a developable patch's curve is thickened into a strip of half-width
   // tol / 2 around a polygon sampled to tol / 2 (see thinStrip below): sampled to tol alone,
@@ -799,6 +1152,7 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
   // left when every edge shared by two of them (traversed once each way) cancels. Handing
   // Boost those few loops instead of thousands of cells makes the union cheap.
   std::map<std::tuple<const PatchData*, int, int>, std::vector<IntPolygon>> sheets;
+  std::size_t lobeCount = 0;
   for (std::size_t i = 0; i < cells.size(); ++i) {
     const CellImage& c = cells[i];
     for (double sign : {1.0, -1.0}) {
@@ -820,9 +1174,35 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
         }
         holdsPole = hasNormal(local, pole);
       }
-      if (!holdsPole && !c.fold) {
-        // Merged below with the other cells of its sheet.
-        sheets[{c.patch, c.curvatureSign, sign > 0.0 ? 1 : -1}].push_back(toPolygon(loop));
+      if (!holdsPole && !c.parts.empty()) {
+        // Merged below with the other cells of its sheet (a fold cell, its two sides).
+        for (const SheetPart& part : c.parts) {
+          std::vector<Vec2> partLoop;
+          for (const Vec3& n : part.normals) partLoop.push_back(project(sign * n));
+          IntPolygon polygon = toPolygon(partLoop);
+          if (c.fold) {
+            // A part beside a parabolic line can have an image thinner than the tolerance:
+            // a crescent between the fold's image and an edge's, tangent where they meet,
+            // or a spike where the line runs close to a patch edge. The polygon's sides,
+            // each within the tolerance of its curve, may then cross, and the lobes they cut
+            // off wind the wrong way, cancelling normals in the sheet. Those lobes (the part
+            // polygon's regions of reversed winding) are added to Omega on their own:
+            // between sides within the tolerance of the true image, they keep Omega within
+            // it too. The Gauss map keeps the orientation of (u, v) where K > 0 (n = r_u x
+            // r_v) and reverses it where K < 0; the antipodal map and the stereographic
+            // projection from the north pole each reverse it: a part (counter-clockwise in
+            // (u, v)) maps to a polygon of orientation -sign(K) for n and sign(K) for -n.
+            const bool counterClockwise = -sign * part.curvatureSign > 0.0;
+            IntPolygonSet lobes;
+            lobes.insert_vertex_sequence(polygon.begin(), polygon.end(),
+                                         counterClockwise ? bp::CLOCKWISE : bp::COUNTERCLOCKWISE, false);
+            std::vector<IntPolygon> pieces;
+            lobes.get(pieces);
+            for (const IntPolygon& piece : pieces) omega.insert(piece);
+            lobeCount += pieces.size();
+          }
+          sheets[{c.patch, part.curvatureSign, sign > 0.0 ? 1 : -1}].push_back(std::move(polygon));
+        }
         continue;
       }
       if (holdsPole) {
@@ -835,7 +1215,18 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
     }
   }
   for (const auto& [unused, polygons] : sheets) {
-    for (const auto& [loop, hole] : mergeSheet(polygons)) omega.insert(loop, hole);
+    // Each sheet is cleaned on its own (its regions of positive winding kept) before it
+    // joins the union, which sums windings: a region a sheet's twisted part winds the wrong
+    // way would otherwise cancel the lobe added for it above.
+    const MergedSheet merged = mergeSheet(polygons);
+    IntPolygonSet sheet;
+    for (const auto& loop : merged.loops) {
+      sheet.insert_vertex_sequence(loop.begin(), loop.end(),
+                                   merged.counterClockwise ? bp::COUNTERCLOCKWISE : bp::CLOCKWISE,
+                                   false);
+    }
+    sheet.clean();
+    omega.insert(sheet);
   }
   // A developable patch among curved ones: its normals form a curve (or a point) that may
   // lie outside the curved patches' region, and they are obstacles for the slicing
@@ -903,6 +1294,11 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
     map.sphereCurves.push_back(std::move(onSphere));
   }
   map.candidatePieces = cells.size();
+  map.parabolicCurves = imageStats.parabolicLines;
+  map.foldCells = foldCells;
+  map.tracedCells = imageStats.tracedCells;
+  map.untracedCells = imageStats.untracedCells;
+  map.reversedLobes = lobeCount;
   return map;
 }
 

@@ -78,6 +78,10 @@ Json documentJson(const OptimalSlicing& result, double toleranceDeg) {
   gaussMap["open_chains"] = map.openChains.size();
   gaussMap["boundary_segments"] = map.boundarySegments;
   gaussMap["parabolic_curves"] = map.parabolicCurves;
+  gaussMap["traced_cells"] = map.tracedCells;
+  gaussMap["fold_cells"] = map.foldCells;
+  gaussMap["untraced_cells"] = map.untracedCells;
+  gaussMap["reversed_lobes"] = map.reversedLobes;
   gaussMap["candidate_pieces"] = map.candidatePieces;
   gaussMap["membership_tests"] = map.membershipTests;
   document["gauss_map"] = gaussMap;

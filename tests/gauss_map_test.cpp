@@ -38,17 +38,20 @@ struct Check {
   std::size_t normals = 0;        // directions tested (each sample and its antipode)
   double worstDepthRad = 0.0;     // deepest tested direction inside the complement
   std::size_t boundaryChecked = 0;
-  double worstOverreachRad = 0.0; // how far Omega's boundary reaches past the sampled image
+  double worstOverreachRad = 0.0; // deepest bound d - gap on a sampled normal near the boundary
 };
 
 // Checks map against the surface's dense normals (n x n per patch):
 // - depth: a normal (or its antipode) inside the complement lies within 2 tol of the
 //   boundary (the clearance in the plane over the projection's scale (1 + |q|^2) / 2 is the
 //   angle on the sphere, to first order);
-// - boundary near the image's edge: from each boundary vertex, the point 2 tol further into
-//   the complement (across the loop) is, where the complement is that wide there (its
-//   clearance at least tol: checkable), at least tol / 2 from every sampled normal. With
-//   the boundary within tol of the true image's edge it is at least tol from the image.
+// - boundary near the image's edge: from each boundary vertex, the point c 2 tol further
+//   into the complement (across the loop) is, where the complement is that wide there (its
+//   clearance d at least tol: checkable), at least d - 1.5 tol from every sampled normal
+//   (no normal near the boundary lies more than 1.5 tol inside the complement). Where the
+//   loop runs straight d is 2 tol and the bound tol / 2; at a corner of the loop c sits
+//   nearer both edges (a 90 degree corner: d = 1.41 tol), and the bound with it, since a
+//   boundary within tol of the true image's edge keeps only d - tol clear of it there.
 Check checkAgainstSamples(const Surface& s, const scallop::GaussMap& map, double tol, int n) {
   Check check;
   scallop::PlanarDomain domain;
@@ -84,17 +87,19 @@ Check checkAgainstSamples(const Surface& s, const scallop::GaussMap& map, double
       const Vec3 across = scallop::normalized(side);
       for (double sign : {1.0, -1.0}) {
         const Vec3 c = std::cos(2.0 * tol) * b + std::sin(2.0 * tol) * (sign * across);
-        if (depthOf(c) < tol) continue;  // not in the complement, or not clearly: unchecked
+        const double depth = depthOf(c);
+        if (depth < tol) continue;  // not in the complement, or not clearly: unchecked
         ++check.boundaryChecked;
+        // A normal within `gap` of c lies at least depth - gap inside the complement.
         const double gap = angleToSamples(normals, c);
-        check.worstOverreachRad = std::max(check.worstOverreachRad, 2.0 * tol - gap);
-        overreaching += gap < 0.5 * tol ? 1 : 0;
+        check.worstOverreachRad = std::max(check.worstOverreachRad, depth - gap);
+        overreaching += depth - gap > 1.5 * tol ? 1 : 0;
       }
     }
   }
   EXPECT_EQ(overreaching, 0u) << "of " << check.boundaryChecked << " boundary points checked lie "
-                              << "more than 1.5 tolerances outside the sampled normals, the "
-                              << "farthest " << check.worstOverreachRad / kDeg << " deg";
+                              << "near a sampled normal more than 1.5 tolerances inside the "
+                              << "complement, the deepest " << check.worstOverreachRad / kDeg << " deg";
   return check;
 }
 
@@ -274,7 +279,8 @@ TEST(GaussMap, DevelopablePatchAmongCurvedOnesIsInOmega) {
 
 TEST(GaussMap, RejectsBadInput) {
   const Surface s = scallop::exampleSurface("paper-1");
-  for (double bad : {0.0, -1.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
+  for (double bad : {0.0, -1.0, std::nan(""), std::numeric_limits<double>::infinity(),
+                     0.5 * scallop::kMinGaussMapToleranceRad}) {
     scallop::GaussMapOptions options;
     options.toleranceRad = bad;
     EXPECT_THROW(scallop::symmetrizedGaussMap(s, options), scallop::Error);

@@ -85,6 +85,8 @@ const std::vector<BadRun>& badRuns() {
        {"tolerance", "'abc'"}},
       {"tolerance too large", nullptr, "", "--example paper-2 --tolerance 10",
        {"tolerance", "'10'", "below 5"}},
+      {"tolerance finer than the grid", nullptr, "", "--example paper-2 --tolerance 1e-12",
+       {"tolerance", "'1e-12'", "at least 5.7e-08 degrees"}},
       {"missing file", nullptr, "", "missing.json --tolerance 1", {"missing.json", "No such file"}},
       {"malformed JSON", "in.json", R"({"units": "in", "patches": [)", "in.json --tolerance 1",
        {"in.json", "malformed JSON"}},

@@ -14,25 +14,43 @@
 //           surface normal `pole` (so that no circle in the complement of Omega passes through
 //           the pole, and the complement's image is bounded): closed loops, the complement of
 //           Omega being the points inside an odd number of loops (even-odd rule).
-// Method: Omega is the union of the images of small pieces of the patches, and of their
-//         antipodes; its boundary then lies on the images of the patch boundaries and of
-//         the parabolic lines (K = 0), as the paper says. A quadtree over each patch,
-//         guided by the Bernstein coefficients of the Gaussian curvature numerator
-//         (variation diminishing), stops at regular cells, where K keeps a strict sign and
-//         the normals vary by less than 0.5 rad (the Gauss map is a local diffeomorphism
-//         there: the image is the region bounded by the images of the cell's four edges),
-//         and at fold cells, across a parabolic line, subdivided until their normals vary
-//         by less than delta (the image: the convex hull of their edges' normals). The pole
-//         is the centre normal of the largest regular cell; everything outside that cell's
-//         projected boundary is in Omega, so each image is clipped to a square around it.
-//         Cell edges are sampled so that the straight polygon edges in the pole frame's
-//         plane (for n and for -n) stay within delta of the curves, and so that
-//         neighbouring cells share their edges' vertices exactly. The cells of one patch
-//         with one sign of K (a sheet, all of one orientation) are merged by cancelling
-//         shared edges; Boost.Polygon unites the sheets, the fold cells and the cells whose
-//         image holds the pole (the outside of their projected boundary, decided by the
-//         membership test below) on an integer grid of 2^29 steps across the pole cell's
-//         loop, and the complement is what remains inside that loop.
+// Method: Omega is the union of the images of the patches, and of their antipodes; its
+//         boundary lies on the images of the patch boundaries and of the parabolic lines
+//         (K = 0), as the paper says (the method of Smith & Farouki 2001). A quadtree over
+//         each patch, guided by the Bernstein coefficients of the Gaussian curvature
+//         numerator (variation diminishing, not a grid), stops at
+//         - regular cells, where K keeps a strict sign and the normals vary by less than
+//           0.5 rad: the Gauss map is a local diffeomorphism, and the image is the region
+//           the images of the cell's four edges bound (with winding);
+//         - traced cells, which a parabolic line crosses as one arc that is a graph v(u) or
+//           u(v) (K strictly monotone in v, or u, by its coefficients, and at most one root
+//           on each edge across): the arc's ends are found on the cell's edges, the arc
+//           itself traced by root-finding across the cell, and the cell split along it into
+//           its K > 0 and K < 0 parts, each bounded by its edges' images and the arc's (the
+//           fold's) image;
+//         - small fold cells elsewhere (where parabolic lines meet or touch, or K vanishes on
+//           a region), subdivided until their normals vary by less than delta: split along
+//           the chord between two crossings, or, failing that, their image taken as the
+//           convex hull of their edges' normals.
+//         Every curve (cell edges, arcs) is sampled so that the straight polygon edges in the
+//         pole frame's plane (for n and for -n) stay within delta of it; neighbouring cells
+//         share their edges' vertices exactly. The parts of one patch with one sign of K (a
+//         sheet, all of one orientation) are merged by cancelling shared edges; Boost.Polygon
+//         then unites the sheets, the hulls and the cells whose image holds the pole (the
+//         outside of their projected boundary, decided by the membership test below) on an
+//         integer grid of 2^29 steps across the pole cell's loop, and the complement is what
+//         remains inside that loop. The pole is the centre normal of the largest regular
+//         cell; a traced cell that might hold it is subdivided instead.
+// Thin images: beside a parabolic line a part's image can be thinner than delta (a crescent
+//         between the fold's image and an edge's, tangent where they meet; a spike where the
+//         line runs close to a patch edge): its polygon's sides, each within delta of its
+//         curve, may cross, and the lobes they cut off wind the wrong way. Those lobes are
+//         added to Omega on their own, and each sheet keeps only its regions of positive
+//         winding, so no true normal is lost to them (a random four-patch surface lost a
+//         3 degree spike that way before).
+// Accuracy: the polygon is within delta of the true boundary, plus the integer grid's
+//         rounding (2^-30 of the pole cell loop's extent: about 1e-9 rad on the paper's
+//         surfaces, which matters only below ~1e-6 degree).
 // Membership: whether a direction m is a normal (isSymmetrizedNormal) is decided exactly in
 //         Bernstein form: whether r_u x r_v is parallel to m (two polynomial equations)
 //         with r_u x r_v . m > 0 somewhere on a patch, by subdivision and Newton's method.
@@ -44,14 +62,11 @@
 //         for a plane) enter Omega as strips of half-width delta / 2 around their polygons,
 //         sampled to delta / 2, so that Omega holds them and its boundary stays within
 //         delta of them.
-// Cost:   O(cells x edge samples) for the images, then the union (Boost's sweep over the
-//         sheets' loops, the fold cells and the strips). The paper's bicubic surfaces at
-//         0.5 degree: ~55 ms (paper-1) and ~120 ms (paper-2). At ~100,000 boundary segments
-//         (paper-1 at 0.0033 degree: 150,000 cells, a third of them fold cells) Boost's
-//         difference takes about two thirds (its input: ~100,000 fold-cell hulls, mutually
-//         overlapping, and the sheets' ~200,000 edges), the quadtree and the edge sampling
-//         most of the rest (each cell evaluates 5 new normals, its corners coming from its
-//         parent; each edge piece is sampled once for its two cells).
+// Cost:   O(cells + boundary samples), then the union (Boost's sweep over the sheets'
+//         loops): the boundary samples grow as delta^-1/2 (chords within delta of curves), so
+//         ~100,000 boundary segments need delta ~5e-7 degree. On the paper's bicubic surfaces
+//         the quadtree stops at some 40 to 90 cells whatever delta is (34 to 48 of them
+//         traced); see the README for times.
 
 #include <cstddef>
 #include <numbers>
@@ -63,8 +78,13 @@
 
 namespace scallop {
 
+/// The finest tolerance accepted: about the resolution of the union's integer grid (2^-30 of
+/// the pole cell's extent; see Accuracy). ~5e-7 degree (8.7e-9 rad) gives ~100,000 segments
+/// on the paper's surfaces; each tenfold refinement triples them.
+inline constexpr double kMinGaussMapToleranceRad = 1e-9;
+
 struct GaussMapOptions {
-  double toleranceRad = 0.1 * std::numbers::pi / 180.0;  ///< polygon-to-curve angle, > 0
+  double toleranceRad = 0.1 * std::numbers::pi / 180.0;  ///< polygon-to-curve angle, >= kMin...
   /// Deepest quadtree level (cells of 2^-depth in u and v), 1 .. 40: a fold cell stops
   /// there even if its normals still vary by more than the tolerance (a parabolic line
   /// where the normal turns faster than 2^depth * tolerance per unit of u or v).
@@ -90,10 +110,14 @@ struct GaussMap {
   /// The boundary of Omega on the unit sphere (original frame), as polylines.
   std::vector<std::vector<Vec3>> sphereCurves;
   std::size_t boundarySegments = 0;  ///< segments in `loops`
-  // Statistics (their names, kept for the JSON output, come from an earlier method).
-  std::size_t parabolicCurves = 0;   ///< fold cells (quadtree cells across a parabolic line)
+  // Statistics.
+  std::size_t parabolicCurves = 0;   ///< parabolic lines (connected chains of arcs, per patch)
+  std::size_t tracedCells = 0;       ///< quadtree cells where a parabolic arc was traced
+  std::size_t foldCells = 0;         ///< small fold cells (normals within the tolerance)
+  std::size_t untracedCells = 0;     ///< traced cells whose edges did not show the arc's ends
+  std::size_t reversedLobes = 0;     ///< twisted lobes of parts beside parabolic lines, added
   std::size_t candidatePieces = 0;   ///< cell images united (all curved patches)
-  std::size_t membershipTests = 0;   ///< always 0: the cell union needs no membership tests
+  std::size_t membershipTests = 0;   ///< always 0: the union needs no membership tests
 };
 
 /// The symmetrized Gauss map of `surface` (see the contract above). Throws scallop::Error on

@@ -38,17 +38,16 @@
 //         only chooses the basin; alpha* is non-decreasing and N* constant once it is fine
 //         enough (the paper's surfaces: from 1 degree on). The certificate states what is
 //         proven.
-// Zigzags: at fine tolerances (paper-1 below ~0.005 degree, paper-2 below ~0.001) the Gauss
-//         map's polygon union can return a loop that runs back and forth over a few grid
-//         steps, and sliver holes; the medial axis rejects those, so vertices where a loop
+// Zigzags: the Gauss map's polygon union can return a loop that runs back and forth over a
+//         few grid steps, and sliver holes (seen at fine tolerances with the earlier
+//         cell-union Gauss map); the medial axis rejects those, so vertices where a loop
 //         turns back within a triangle thinner than 1% of the tolerance are removed, and
 //         loops of negligible area dropped, before it (the boundary moves by less than that).
-// Cost:   dominated by the Gauss map. The paper's bicubic surfaces at 0.5 degree: ~50 ms
-//         (paper-1) and ~90 ms (paper-2) of CPU, of which the Gauss map 40 / 85 ms, the
-//         medial axis 9 / 4, eq (13) 1.5 / 1, the polish (8 seeds) 3, the certificate < 1. At
-//         ~100,000 boundary segments (0.0033 / 0.001 degree): ~12 s / ~60 s, the Gauss map
-//         ~8.5 s / ~56 s (two thirds of it Boost's final difference, see gauss_map.hpp), the
-//         medial axis 3.4 s / 2.9 s, eq (13) 0.5 s / 0.5 s.
+// Cost:   the paper's bicubic surfaces at 0.5 degree: ~24 ms (paper-1) and ~29 ms
+//         (paper-2) of CPU, of which the Gauss map 8 / 11 ms and the medial axis 7 / 6. At
+//         ~100,000 boundary segments (5e-7 degree on both): ~10 s / ~14 s, the Gauss map
+//         ~4 s / ~9 s and the medial axis ~5 s (Boost's Voronoi falls back to its
+//         multiprecision predicates on the finely sampled, nearly collinear boundary).
 // Degenerate surfaces: a plane (Omega two points) gives alpha* = 90 degrees with N* any
 //         direction orthogonal to the normal (one is returned); for a surface whose Gauss
 //         image is a curve (K = 0) the result is found by maximising the minimum angle over
@@ -67,10 +66,10 @@
 namespace scallop {
 
 struct OptimalSlicingOptions {
-  /// Gauss-map polygon tolerance, in (0, 0.1) rad. 0.5 degree gives a few hundred boundary
-  /// segments on the paper's surfaces, as the paper used; N* is polished on the true
-  /// surface afterwards, so a finer tolerance changes it only when it moves the medial axis
-  /// to another basin. ~0.0033 degree (paper-1) and ~0.001 (paper-2) give ~100,000 segments.
+  /// Gauss-map polygon tolerance, in (0, 0.1) rad. 0.5 degree gives 120-160 boundary
+  /// segments on the paper's surfaces (the paper used a few hundred); N* is polished on the
+  /// true surface afterwards, so a finer tolerance changes it only when it moves the medial
+  /// axis to another basin. ~5e-7 degree gives ~100,000 segments on either surface.
   double toleranceRad = 0.5 * std::numbers::pi / 180.0;
   bool certify = true;  ///< run the Bernstein-form certificate
 };

@@ -19,8 +19,9 @@
 //    "pole": [x, y, z]                       the surface normal used as the pole,
 //    "tolerance_deg": t                      the Gauss-map tolerance the caller used,
 //    "gauss_map": {"kind": "region" | "curve" | "point", "loops", "open_chains",
-//                  "boundary_segments", "parabolic_curves", "candidate_pieces",
-//                  "membership_tests"}       counts,
+//                  "boundary_segments", "parabolic_curves" (connected parabolic lines),
+//                  "traced_cells", "fold_cells", "untraced_cells", "reversed_lobes",
+//                  "candidate_pieces", "membership_tests"}   counts (see GaussMap),
 //    "medial_axis": {"edges", "rebuilds"},
 //    "seconds": s}                           wall time of optimalSlicing
 //
