@@ -686,6 +686,40 @@ struct CellBuilder {
       }
       return out;
     };
+    // An edge piece shared by two regular cells of one sign, neither of which holds +-pole,
+    // lies inside their sheet: both cells run it, opposite ways, and mergeSheet cancels it
+    // whatever its polygon, the sliver between polygon and curve counting for one cell as
+    // much as against the other. Such a piece is sampled at its ends alone. (Most pieces
+    // are such at fine tolerances; a cell holding the pole keeps its image as the outside
+    // of its own loop, so its pieces are sampled to the tolerance.)
+    auto key = [](bool alongU, double fixed, double t0, double t1) {
+      return std::array<double, 3>{alongU ? fixed : -1.0 - fixed, t0, t1};
+    };
+    auto interiorSign = [&](const Cell& c) {
+      if (c.fold || (avoid != nullptr && mayHold(c.u0, c.u1, c.v0, c.v1, c.centre, c.spread, *avoid))) {
+        return 0;
+      }
+      return c.curvatureSign;
+    };
+    struct PieceUse {
+      int users = 0;
+      int sign = 0;  // the users' common interior sign, or 0
+    };
+    std::map<std::array<double, 3>, PieceUse> uses;
+    for (const Cell& c : cells) {
+      const int sign = interiorSign(c);
+      auto note = [&](const std::vector<double>& ts, bool alongU, double fixed) {
+        for (std::size_t i = 0; i + 1 < ts.size(); ++i) {
+          PieceUse& use = uses[key(alongU, fixed, ts[i], ts[i + 1])];
+          use.sign = use.users == 0 || use.sign == sign ? sign : 0;
+          ++use.users;
+        }
+      };
+      note(cuts(onV.at(c.v0), c.u0, c.u1), true, c.v0);
+      note(cuts(onU.at(c.u1), c.v0, c.v1), false, c.u1);
+      note(cuts(onV.at(c.v1), c.u0, c.u1), true, c.v1);
+      note(cuts(onU.at(c.u0), c.v0, c.v1), false, c.u0);
+    }
     std::map<std::array<double, 3>, EdgeSamples> pieces;
     std::vector<CellImage> out;
     out.reserve(cells.size());
@@ -706,17 +740,25 @@ struct CellBuilder {
       // Each elementary piece is shared by at most two cells (which run it opposite ways):
       // sampled once, kept until its second use.
       auto piece = [&](bool alongU, double fixed, double t0, double t1) {
-        const std::array<double, 3> key{alongU ? fixed : -1.0 - fixed, t0, t1};
-        auto it = pieces.find(key);
+        const std::array<double, 3> pieceKey = key(alongU, fixed, t0, t1);
+        auto it = pieces.find(pieceKey);
         if (it != pieces.end()) {
           EdgeSamples samples = std::move(it->second);
           pieces.erase(it);
           return samples;
         }
-        EdgeSamples samples =
-            alongU ? sampleEdgeWithSigns(sampler, {t0, fixed}, {t1, fixed}, c.curvatureSign)
-                   : sampleEdgeWithSigns(sampler, {fixed, t0}, {fixed, t1}, c.curvatureSign);
-        pieces.emplace(key, samples);
+        const UV a = alongU ? UV{t0, fixed} : UV{fixed, t0};
+        const UV b = alongU ? UV{t1, fixed} : UV{fixed, t1};
+        const PieceUse& use = uses.at(pieceKey);
+        EdgeSamples samples;
+        if (use.users == 2 && use.sign != 0) {
+          samples.normals = {normalAt(a.u, a.v), normalAt(b.u, b.v)};
+          samples.signs.assign(2, static_cast<signed char>(use.sign));
+          samples.where = {a, b};
+        } else {
+          samples = sampleEdgeWithSigns(sampler, a, b, c.curvatureSign);
+        }
+        pieces.emplace(pieceKey, samples);
         return samples;
       };
       auto forward = [&](const std::vector<double>& ts, bool alongU, double fixed) {

@@ -33,8 +33,9 @@
 //           the chord between two crossings, or, failing that, their image taken as the
 //           convex hull of their edges' normals.
 //         Every curve (cell edges, arcs) is sampled so that the straight polygon edges in the
-//         pole frame's plane (for n and for -n) stay within delta of it; neighbouring cells
-//         share their edges' vertices exactly. The parts of one patch with one sign of K (a
+//         pole frame's plane (for n and for -n) stay within delta of it (an edge between
+//         two regular cells of one sheet, which cancels, at its ends alone); neighbouring
+//         cells share their edges' vertices exactly. The parts of one patch with one sign of K (a
 //         sheet, all of one orientation) are merged by cancelling shared edges; Boost.Polygon
 //         then unites the sheets, the hulls and the cells whose image holds the pole (the
 //         outside of their projected boundary, decided by the membership test below) on an
