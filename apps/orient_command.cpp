@@ -50,10 +50,7 @@ struct OrientOptions {
 
 // Checks the combination of options, which CLI11 cannot express.
 void checkOptions(const OrientOptions& options) {
-  if (options.surface.input.empty() == options.surface.example.empty()) {
-    throw CLI::ValidationError("orient",
-                               "give the surface either as SURFACE.json or as --example NAME");
-  }
+  requireOneSurfaceSource(options.surface, "orient");
   if (options.svgDir == kStandardStream) {
     throw CLI::ValidationError("orient", "--svg-dir needs a directory, not standard output");
   }

@@ -43,8 +43,7 @@ struct PathsOptions {
 };
 
 void runPaths(const PathsOptions& options) {
-  if (options.surface.input.empty() == options.surface.example.empty())
-    throw CLI::ValidationError("paths", "give the surface either as SURFACE.json or as --example NAME");
+  requireOneSurfaceSource(options.surface, "paths");
   if (options.spacing.empty() == options.scallopHeight.empty())
     throw CLI::ValidationError("paths", "give exactly one of --spacing and --scallop-height");
   if (options.strategy == "contour" && !options.angle.empty())

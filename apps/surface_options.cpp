@@ -11,6 +11,12 @@ void addSurfaceSourceOptions(CLI::App& command, SurfaceSource& source, const std
   file->excludes(example);
 }
 
+void requireOneSurfaceSource(const SurfaceSource& source, const std::string& command) {
+  if (source.input.empty() == source.example.empty()) {
+    throw CLI::ValidationError(command, "give the surface either as SURFACE.json or as --example NAME");
+  }
+}
+
 Surface loadSurface(const SurfaceSource& source) {
   return source.example.empty() ? readSurface(source.input) : exampleSurface(source.example);
 }

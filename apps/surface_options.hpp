@@ -23,6 +23,10 @@ struct SurfaceSource {
 void addSurfaceSourceOptions(CLI::App& command, SurfaceSource& source, const std::string& fileHelp,
                              const std::string& exampleHelp);
 
+/// Throws CLI::ValidationError for `command` unless exactly one of the file and the example
+/// is given.
+void requireOneSurfaceSource(const SurfaceSource& source, const std::string& command);
+
 /// The surface: the example if named, else the file (scallop::Error naming the file on bad
 /// input).
 Surface loadSurface(const SurfaceSource& source);

@@ -38,8 +38,6 @@ struct PatchData {
   const BezierPatch* patch = nullptr;
   std::array<Bernstein2, 3> normal;  // r_u x r_v, exact Bernstein form
   Bernstein2 curvature;              // Gaussian curvature numerator (sign of K)
-  Bernstein2 curvatureU;             // its partial derivatives
-  Bernstein2 curvatureV;
   bool developable = false;          // K = 0 identically (to rounding)
 };
 
@@ -48,8 +46,6 @@ PatchData makePatchData(const BezierPatch& patch) {
   data.patch = &patch;
   data.normal = normalPolynomials(patch);
   data.curvature = gaussianCurvatureNumerator(patch);
-  data.curvatureU = derivativeU(data.curvature);
-  data.curvatureV = derivativeV(data.curvature);
   // K's numerator is (r_uu . N)(r_vv . N) - (r_uv . N)^2, of the order of |N|^2 |r''|^2: call
   // it identically zero when every coefficient is below 1e-12 of that scale. |r''| is taken
   // at least 1e-6 |r'|: a plane whose control points carry rounding has second derivatives
@@ -298,15 +294,14 @@ struct SheetPart {
 struct CellImage {
   std::vector<Vec3> normals;  // the images of the cell's boundary, a loop
   bool fold = false;          // a fold cell (see CellBuilder::split)
-  /// The cell's parts for the sheets: the whole cell for a regular cell, and for a fold
-  /// cell its two sides of the parabolic line (or the whole cell where K keeps one sign on
-  /// its boundary); empty when a fold cell takes the hull of `normals` instead.
+  /// A fold cell's parts for the sheets: its two sides of the parabolic line (or the whole
+  /// cell where K keeps one sign on its boundary); empty when it takes the hull of `normals`
+  /// instead. A regular cell is one part: `normals`, with `curvatureSign`.
   std::vector<SheetPart> parts;
-  Vec3 centre;                // the normal at the cell's centre
-  double spread = 0.0;        // largest angle from `centre` to a normal of the cell (sampled)
-  double area = 0.0;          // parameter area, to pick the pole cell
+  /// Whether the cell has the normal pole (first) and -pole (second): its image is then the
+  /// outside of its projected loop.
+  std::array<bool, 2> holdsPole{false, false};
   const PatchData* patch = nullptr;
-  double u0 = 0.0, u1 = 1.0, v0 = 0.0, v1 = 1.0;
   int curvatureSign = 0;      // regular cells: the sign of K (cells of one sign form a sheet)
 };
 
@@ -376,17 +371,23 @@ struct CellBuilder {
   // Cells not to trace (their edges did not show two crossings in an earlier run).
   std::set<std::array<double, 4>> noTrace;
 
-  // Whether the cell may have the normal +-m: decided exactly in Bernstein form where its
-  // sampled normals come within twice their spread of it.
-  bool mayHold(double u0, double u1, double v0, double v1, const Vec3& centre, double spread,
-               const Vec3& m) const {
-    for (double sign : {1.0, -1.0}) {
-      if (angleBetween(centre, sign * m) > 2.0 * spread + tol) continue;
+  // Whether the cell has the normal m (first) and -m (second): decided exactly in Bernstein
+  // form where its sampled normals come within twice their spread of it.
+  std::array<bool, 2> holds(double u0, double u1, double v0, double v1, const Vec3& centre,
+                            double spread, const Vec3& m) const {
+    std::array<bool, 2> out{false, false};
+    for (std::size_t k = 0; k < 2; ++k) {
+      const Vec3 target = k == 0 ? m : -m;
+      if (angleBetween(centre, target) > 2.0 * spread + tol) continue;
       std::array<Bernstein2, 3> local;
       for (std::size_t i = 0; i < 3; ++i) local[i] = restrictTo(data.normal[i], u0, u1, v0, v1);
-      if (hasNormal(local, sign * m)) return true;
+      out[k] = hasNormal(local, target);
     }
-    return false;
+    return out;
+  }
+  bool holdsEither(const Cell& c, const Vec3& m) const {
+    const std::array<bool, 2> h = holds(c.u0, c.u1, c.v0, c.v1, c.centre, c.spread, m);
+    return h[0] || h[1];
   }
 
   Vec3 normalAt(double u, double v) const { return unitNormal(*data.patch, u, v); }
@@ -416,10 +417,10 @@ struct CellBuilder {
       return;
     }
     if (spread <= kRegularCellSpread) {
-      const int axis = traceAxis(k);
-      if (axis != 0 && !(avoid != nullptr && mayHold(u0, u1, v0, v1, centre, spread, *avoid)) &&
-          !noTrace.contains({u0, u1, v0, v1})) {
-        cells.push_back({u0, u1, v0, v1, true, centre, spread, 0, axis});
+      const Cell traced{u0, u1, v0, v1, true, centre, spread, 0, traceAxis(k)};
+      if (traced.traceAxis != 0 && !noTrace.contains(boundsOf(traced)) &&
+          !(avoid != nullptr && holdsEither(traced, *avoid))) {
+        cells.push_back(traced);
         return;
       }
     }
@@ -625,7 +626,8 @@ struct CellBuilder {
   struct ImageStats {
     std::size_t parabolicLines = 0;  // connected pieces of parabolic line (chains of arcs)
     std::size_t tracedCells = 0;     // fold cells whose line was traced
-    std::size_t untracedCells = 0;   // traced cells whose edges did not show two crossings
+    std::size_t untracedCells = 0;   // traced cells whose edges did not show two crossings,
+                                     // subdivided in a rerun (counted over every run)
   };
 
   // The number of connected chains among parabolic-line arcs given by their end points
@@ -677,123 +679,117 @@ struct CellBuilder {
         values.erase(std::unique(values.begin(), values.end()), values.end());
       }
     }
-    // The cut points of [a, b] on a line, increasing.
-    auto cuts = [](const std::vector<double>& values, double a, double b) {
-      std::vector<double> out;
-      for (auto it = std::lower_bound(values.begin(), values.end(), a);
-           it != values.end() && *it <= b; ++it) {
-        out.push_back(*it);
-      }
+    // The elementary pieces of a cell's edges, in the loop's order: bottom (v = v0, u up),
+    // right (u = u1, v up), top (v = v1, u down), left (u = u0, v down), each cut at every
+    // corner on it (its cut points on the line, increasing, taken forward or backward).
+    struct EdgePiece {
+      bool alongU;      // along u at v = fixed, or along v at u = fixed
+      double fixed, t0, t1;  // t0 < t1
+      bool backward;    // the loop runs it from t1 to t0
+    };
+    auto edgePieces = [&](const Cell& c) {
+      std::vector<EdgePiece> out;
+      auto add = [&](const std::vector<double>& values, bool alongU, double fixed, double a,
+                     double b, bool backward) {
+        std::vector<double> ts;
+        for (auto it = std::lower_bound(values.begin(), values.end(), a);
+             it != values.end() && *it <= b; ++it) {
+          ts.push_back(*it);
+        }
+        const std::size_t first = out.size();
+        for (std::size_t i = 0; i + 1 < ts.size(); ++i) {
+          out.push_back({alongU, fixed, ts[i], ts[i + 1], backward});
+        }
+        if (backward) std::reverse(out.begin() + static_cast<std::ptrdiff_t>(first), out.end());
+      };
+      add(onV.at(c.v0), true, c.v0, c.u0, c.u1, false);
+      add(onU.at(c.u1), false, c.u1, c.v0, c.v1, false);
+      add(onV.at(c.v1), true, c.v1, c.u0, c.u1, true);
+      add(onU.at(c.u0), false, c.u0, c.v0, c.v1, true);
       return out;
     };
+    auto key = [](const EdgePiece& e) {
+      return std::array<double, 3>{e.alongU ? e.fixed : -1.0 - e.fixed, e.t0, e.t1};
+    };
+    // Which cells hold +-pole (see `avoid`), decided once: for their pieces' sampling below
+    // and for the union, which takes such a cell's image as the outside of its loop.
+    std::vector<std::array<bool, 2>> poleHeld(cells.size(), {false, false});
+    if (avoid != nullptr) {
+      for (std::size_t i = 0; i < cells.size(); ++i) {
+        const Cell& c = cells[i];
+        poleHeld[i] = holds(c.u0, c.u1, c.v0, c.v1, c.centre, c.spread, *avoid);
+      }
+    }
     // An edge piece shared by two regular cells of one sign, neither of which holds +-pole,
     // lies inside their sheet: both cells run it, opposite ways, and mergeSheet cancels it
     // whatever its polygon, the sliver between polygon and curve counting for one cell as
     // much as against the other. Such a piece is sampled at its ends alone. (Most pieces
     // are such at fine tolerances; a cell holding the pole keeps its image as the outside
     // of its own loop, so its pieces are sampled to the tolerance.)
-    auto key = [](bool alongU, double fixed, double t0, double t1) {
-      return std::array<double, 3>{alongU ? fixed : -1.0 - fixed, t0, t1};
-    };
-    auto interiorSign = [&](const Cell& c) {
-      if (c.fold || (avoid != nullptr && mayHold(c.u0, c.u1, c.v0, c.v1, c.centre, c.spread, *avoid))) {
-        return 0;
-      }
-      return c.curvatureSign;
-    };
     struct PieceUse {
       int users = 0;
       int sign = 0;  // the users' common interior sign, or 0
     };
     std::map<std::array<double, 3>, PieceUse> uses;
-    for (const Cell& c : cells) {
-      const int sign = interiorSign(c);
-      auto note = [&](const std::vector<double>& ts, bool alongU, double fixed) {
-        for (std::size_t i = 0; i + 1 < ts.size(); ++i) {
-          PieceUse& use = uses[key(alongU, fixed, ts[i], ts[i + 1])];
-          use.sign = use.users == 0 || use.sign == sign ? sign : 0;
-          ++use.users;
-        }
-      };
-      note(cuts(onV.at(c.v0), c.u0, c.u1), true, c.v0);
-      note(cuts(onU.at(c.u1), c.v0, c.v1), false, c.u1);
-      note(cuts(onV.at(c.v1), c.u0, c.u1), true, c.v1);
-      note(cuts(onU.at(c.u0), c.v0, c.v1), false, c.u0);
+    std::vector<std::vector<EdgePiece>> cellPieces(cells.size());
+    for (std::size_t i = 0; i < cells.size(); ++i) {
+      const Cell& c = cells[i];
+      const int sign = c.fold || poleHeld[i][0] || poleHeld[i][1] ? 0 : c.curvatureSign;
+      cellPieces[i] = edgePieces(c);
+      for (const EdgePiece& e : cellPieces[i]) {
+        PieceUse& use = uses[key(e)];
+        use.sign = use.users == 0 || use.sign == sign ? sign : 0;
+        ++use.users;
+      }
     }
+    // Each elementary piece is shared by at most two cells (which run it opposite ways):
+    // sampled once, in increasing parameter, and kept until its second use.
     std::map<std::array<double, 3>, EdgeSamples> pieces;
     std::vector<CellImage> out;
     out.reserve(cells.size());
-    for (const Cell& c : cells) {
+    for (std::size_t index = 0; index < cells.size(); ++index) {
+      const Cell& c = cells[index];
       CellImage image;
       image.fold = c.fold;
-      image.centre = c.centre;
-      image.area = (c.u1 - c.u0) * (c.v1 - c.v0);
-      image.spread = c.spread;
+      image.holdsPole = poleHeld[index];
       image.patch = &data;
       image.curvatureSign = c.curvatureSign;
-      image.u0 = c.u0, image.u1 = c.u1, image.v0 = c.v0, image.v1 = c.v1;
       auto& loop = image.normals;
       std::vector<signed char> signs;
       std::vector<UV> where;
-      // Bottom (v = v0, u up), right (u = u1, v up), top (v = v1, u down), left (u = u0, v
-      // down); each elementary piece sampled in increasing parameter, reversed as needed.
-      // Each elementary piece is shared by at most two cells (which run it opposite ways):
-      // sampled once, kept until its second use.
-      auto piece = [&](bool alongU, double fixed, double t0, double t1) {
-        const std::array<double, 3> pieceKey = key(alongU, fixed, t0, t1);
-        auto it = pieces.find(pieceKey);
-        if (it != pieces.end()) {
-          EdgeSamples samples = std::move(it->second);
-          pieces.erase(it);
-          return samples;
-        }
-        const UV a = alongU ? UV{t0, fixed} : UV{fixed, t0};
-        const UV b = alongU ? UV{t1, fixed} : UV{fixed, t1};
-        const PieceUse& use = uses.at(pieceKey);
+      for (const EdgePiece& e : cellPieces[index]) {
+        const std::array<double, 3> pieceKey = key(e);
         EdgeSamples samples;
-        if (use.users == 2 && use.sign != 0) {
-          samples.normals = {normalAt(a.u, a.v), normalAt(b.u, b.v)};
-          samples.signs.assign(2, static_cast<signed char>(use.sign));
-          samples.where = {a, b};
+        if (auto it = pieces.find(pieceKey); it != pieces.end()) {
+          samples = std::move(it->second);
+          pieces.erase(it);
         } else {
-          samples = sampleEdgeWithSigns(sampler, a, b, c.curvatureSign);
-        }
-        pieces.emplace(pieceKey, samples);
-        return samples;
-      };
-      auto forward = [&](const std::vector<double>& ts, bool alongU, double fixed) {
-        for (std::size_t i = 0; i + 1 < ts.size(); ++i) {
-          const EdgeSamples samples = piece(alongU, fixed, ts[i], ts[i + 1]);
-          loop.insert(loop.end(), samples.normals.begin(), samples.normals.end() - 1);
-          signs.insert(signs.end(), samples.signs.begin(), samples.signs.end() - 1);
-          where.insert(where.end(), samples.where.begin(), samples.where.end() - 1);
-        }
-      };
-      auto backward = [&](const std::vector<double>& ts, bool alongU, double fixed) {
-        for (std::size_t i = ts.size() - 1; i > 0; --i) {
-          // The piece [t_{i-1}, t_i] in increasing order: emit t_i down to t_{i-1}, exclusive.
-          const EdgeSamples samples = piece(alongU, fixed, ts[i - 1], ts[i]);
-          for (std::size_t j = samples.normals.size() - 1; j > 0; --j) {
-            loop.push_back(samples.normals[j]);
-            signs.push_back(samples.signs[j]);
-            where.push_back(samples.where[j]);
+          const UV a = e.alongU ? UV{e.t0, e.fixed} : UV{e.fixed, e.t0};
+          const UV b = e.alongU ? UV{e.t1, e.fixed} : UV{e.fixed, e.t1};
+          const PieceUse& use = uses.at(pieceKey);
+          if (use.users == 2 && use.sign != 0) {
+            samples.normals = {normalAt(a.u, a.v), normalAt(b.u, b.v)};
+            samples.signs.assign(2, static_cast<signed char>(use.sign));
+            samples.where = {a, b};
+          } else {
+            samples = sampleEdgeWithSigns(sampler, a, b, c.curvatureSign);
           }
+          pieces.emplace(pieceKey, samples);
         }
-      };
-      forward(cuts(onV.at(c.v0), c.u0, c.u1), true, c.v0);
-      forward(cuts(onU.at(c.u1), c.v0, c.v1), false, c.u1);
-      backward(cuts(onV.at(c.v1), c.u0, c.u1), true, c.v1);
-      backward(cuts(onU.at(c.u0), c.v0, c.v1), false, c.u0);
+        // Emitted from its start in the loop's sense, its last sample left to the next piece.
+        const std::size_t n = samples.normals.size();
+        for (std::size_t j = 0; j + 1 < n; ++j) {
+          const std::size_t k = e.backward ? n - 1 - j : j;
+          loop.push_back(samples.normals[k]);
+          signs.push_back(samples.signs[k]);
+          where.push_back(samples.where[k]);
+        }
+      }
       if (c.fold) {
         std::pair<UV, UV> crossing;
         image.parts = split(c, sampler, loop, signs, where, &crossing);
         if (image.parts.size() == 2) arcs.emplace_back(crossing.first, crossing.second);
-        if (image.parts.empty() && c.traceAxis != 0) {
-          ++stats.untracedCells;
-          untraceable.push_back(boundsOf(c));
-        }
-      } else {
-        image.parts = {SheetPart{loop, c.curvatureSign}};
+        if (image.parts.empty() && c.traceAxis != 0) untraceable.push_back(boundsOf(c));
       }
       out.push_back(std::move(image));
     }
@@ -1013,8 +1009,9 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
   }
   if (tol < kMinGaussMapToleranceRad) {
     throw Error(fmt::format("the Gauss map tolerance {} rad is finer than its integer grid "
-                            "resolves; the least is {} rad ({} degree)",
-                            tol, kMinGaussMapToleranceRad, kMinGaussMapToleranceRad * 180.0 / std::numbers::pi));
+                            "resolves; the least is {} rad ({} degree)", tol,
+                            kMinGaussMapToleranceRad,
+                            kMinGaussMapToleranceRad * 180.0 / std::numbers::pi));
   }
   if (options.maxCellDepth < 1 || options.maxCellDepth > 40) {
     throw Error(fmt::format("the Gauss map's deepest quadtree level must be 1 .. 40, got {}",
@@ -1074,7 +1071,7 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
         b == poleBuilder ? CellBuilder::boundsOf(builder.cells[poleIndex]) : CellBuilder::CellBounds{};
     builder.avoid = &map.pole;
     bool rerun = std::any_of(builder.cells.begin(), builder.cells.end(), [&](const Cell& c) {
-      return c.traceAxis != 0 && builder.mayHold(c.u0, c.u1, c.v0, c.v1, c.centre, c.spread, map.pole);
+      return c.traceAxis != 0 && builder.holdsEither(c, map.pole);
     });
     std::vector<CellImage> images;
     CellBuilder::ImageStats stats;
@@ -1086,6 +1083,7 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
       std::vector<CellBuilder::CellBounds> untraceable;
       stats = {};
       images = builder.images(sampler, stats, untraceable);
+      imageStats.untracedCells += untraceable.size();  // over every run
       if (untraceable.empty()) break;
       builder.noTrace.insert(untraceable.begin(), untraceable.end());
       rerun = true;
@@ -1097,7 +1095,6 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
     }
     imageStats.parabolicLines += stats.parabolicLines;
     imageStats.tracedCells += stats.tracedCells;
-    imageStats.untracedCells += stats.untracedCells;
     for (const Cell& c : builder.cells) foldCells += c.fold && c.traceAxis == 0 ? 1 : 0;
     for (auto& c : images) cells.push_back(std::move(c));
   }
@@ -1175,10 +1172,10 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
   };
 
   using namespace boost::polygon::operators;
-  IntPolygonSet inside;
-  inside.insert(toPolygon(outer));
-  IntPolygonSet omega;
   const IntPolygon outerPolygon = toPolygon(outer);
+  IntPolygonSet inside;
+  inside.insert(outerPolygon);
+  IntPolygonSet omega;
   // An image that holds the pole is the outside of its projected loop (within the window).
   const auto insertOutside = [&](const std::vector<Vec2>& loop) {
     IntPolygonSet ring;
@@ -1195,58 +1192,55 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
   // Boost those few loops instead of thousands of cells makes the union cheap.
   std::map<std::tuple<const PatchData*, int, int>, std::vector<IntPolygon>> sheets;
   std::size_t lobeCount = 0;
+  // A loop of normals (for n, or -n) into its sheet; for a part beside a parabolic line
+  // (`twists`), with its lobes of reversed winding added to Omega on their own. Such a part
+  // can have an image thinner than the tolerance: a crescent between the fold's image and
+  // an edge's, tangent where they meet, or a spike where the line runs close to a patch
+  // edge. The polygon's sides, each within the tolerance of its curve, may then cross, and
+  // the lobes they cut off wind the wrong way, cancelling normals in the sheet; between
+  // sides within the tolerance of the true image, the lobes keep Omega within it too. The
+  // Gauss map keeps the orientation of (u, v) where K > 0 (n = r_u x r_v) and reverses it
+  // where K < 0; the antipodal map and the stereographic projection from the north pole
+  // each reverse it: a part (counter-clockwise in (u, v)) maps to a polygon of orientation
+  // -sign(K) for n and sign(K) for -n.
+  const auto addToSheet = [&](const CellImage& c, const std::vector<Vec3>& normals,
+                              int curvatureSign, double sign, bool twists) {
+    std::vector<Vec2> loop;
+    loop.reserve(normals.size());
+    for (const Vec3& n : normals) loop.push_back(project(sign * n));
+    IntPolygon polygon = toPolygon(loop);
+    if (twists) {
+      const bool counterClockwise = -sign * curvatureSign > 0.0;
+      IntPolygonSet lobes;
+      lobes.insert_vertex_sequence(polygon.begin(), polygon.end(),
+                                   counterClockwise ? bp::CLOCKWISE : bp::COUNTERCLOCKWISE, false);
+      std::vector<IntPolygon> pieces;
+      lobes.get(pieces);
+      for (const IntPolygon& piece : pieces) omega.insert(piece);
+      lobeCount += pieces.size();
+    }
+    sheets[{c.patch, curvatureSign, sign > 0.0 ? 1 : -1}].push_back(std::move(polygon));
+  };
   for (std::size_t i = 0; i < cells.size(); ++i) {
     const CellImage& c = cells[i];
     for (double sign : {1.0, -1.0}) {
       if (i == poleCell && sign > 0.0) continue;
+      // A cell whose image holds the pole (the Gauss map covers the pole more than once) is
+      // the outside of its projected boundary: within the pole cell's loop, that loop's
+      // region minus the cell loop's inside (decided in CellBuilder::images).
+      const bool holdsPole = c.holdsPole[sign > 0.0 ? 0 : 1];
+      if (!holdsPole && !c.fold) {
+        addToSheet(c, c.normals, c.curvatureSign, sign, false);  // merged below
+        continue;
+      }
+      if (!holdsPole && !c.parts.empty()) {
+        for (const SheetPart& part : c.parts) addToSheet(c, part.normals, part.curvatureSign, sign, true);
+        continue;
+      }
       std::vector<Vec2> loop;
       for (const Vec3& n : c.normals) loop.push_back(project(sign * n));
       if (c.fold) loop = convexHull(std::move(loop));
       if (loop.size() < 3) continue;
-      // A cell whose image holds the pole (the Gauss map covers the pole more than once) is
-      // the outside of its projected boundary: within the pole cell's loop, that loop's
-      // region minus the cell loop's inside. Decided exactly when the sampled spread leaves
-      // it possible (the cell's sampled normals come within twice their spread of the pole).
-      const Vec3 pole = sign * map.pole;
-      bool holdsPole = false;
-      if (angleBetween(c.centre, pole) <= 2.0 * c.spread + tol) {
-        std::array<Bernstein2, 3> local;
-        for (std::size_t k = 0; k < 3; ++k) {
-          local[k] = restrictTo(c.patch->normal[k], c.u0, c.u1, c.v0, c.v1);
-        }
-        holdsPole = hasNormal(local, pole);
-      }
-      if (!holdsPole && !c.parts.empty()) {
-        // Merged below with the other cells of its sheet (a fold cell, its two sides).
-        for (const SheetPart& part : c.parts) {
-          std::vector<Vec2> partLoop;
-          for (const Vec3& n : part.normals) partLoop.push_back(project(sign * n));
-          IntPolygon polygon = toPolygon(partLoop);
-          if (c.fold) {
-            // A part beside a parabolic line can have an image thinner than the tolerance:
-            // a crescent between the fold's image and an edge's, tangent where they meet,
-            // or a spike where the line runs close to a patch edge. The polygon's sides,
-            // each within the tolerance of its curve, may then cross, and the lobes they cut
-            // off wind the wrong way, cancelling normals in the sheet. Those lobes (the part
-            // polygon's regions of reversed winding) are added to Omega on their own:
-            // between sides within the tolerance of the true image, they keep Omega within
-            // it too. The Gauss map keeps the orientation of (u, v) where K > 0 (n = r_u x
-            // r_v) and reverses it where K < 0; the antipodal map and the stereographic
-            // projection from the north pole each reverse it: a part (counter-clockwise in
-            // (u, v)) maps to a polygon of orientation -sign(K) for n and sign(K) for -n.
-            const bool counterClockwise = -sign * part.curvatureSign > 0.0;
-            IntPolygonSet lobes;
-            lobes.insert_vertex_sequence(polygon.begin(), polygon.end(),
-                                         counterClockwise ? bp::CLOCKWISE : bp::COUNTERCLOCKWISE, false);
-            std::vector<IntPolygon> pieces;
-            lobes.get(pieces);
-            for (const IntPolygon& piece : pieces) omega.insert(piece);
-            lobeCount += pieces.size();
-          }
-          sheets[{c.patch, part.curvatureSign, sign > 0.0 ? 1 : -1}].push_back(std::move(polygon));
-        }
-        continue;
-      }
       if (holdsPole) {
         insertOutside(loop);
       } else {

@@ -1,6 +1,6 @@
 // The symmetrized Gauss map against dense samples of the surface normals, written here:
-// every sampled normal and its antipode must lie in Omega (or within two tolerances of its
-// boundary), and Omega's boundary must lie near the sampled image's edge.
+// every sampled normal and its antipode must lie in Omega (or within one tolerance of its
+// boundary, as the contract says), and Omega's boundary must lie near the sampled image's edge.
 
 #include <gtest/gtest.h>
 
@@ -42,7 +42,7 @@ struct Check {
 };
 
 // Checks map against the surface's dense normals (n x n per patch):
-// - depth: a normal (or its antipode) inside the complement lies within 2 tol of the
+// - depth: a normal (or its antipode) inside the complement lies within tol of the
 //   boundary (the clearance in the plane over the projection's scale (1 + |q|^2) / 2 is the
 //   angle on the sphere, to first order);
 // - boundary near the image's edge: from each boundary vertex, the point c 2 tol further
@@ -70,10 +70,10 @@ Check checkAgainstSamples(const Surface& s, const scallop::GaussMap& map, double
       const double depth = depthOf(sign * normal);
       ++check.normals;
       check.worstDepthRad = std::max(check.worstDepthRad, depth);
-      deep += depth > 2.0 * tol ? 1 : 0;
+      deep += depth > tol ? 1 : 0;
     }
   }
-  EXPECT_EQ(deep, 0u) << "of " << check.normals << " sampled normals lie more than two tolerances "
+  EXPECT_EQ(deep, 0u) << "of " << check.normals << " sampled normals lie more than one tolerance "
                       << "inside the complement of Omega, the deepest " << check.worstDepthRad / kDeg << " deg";
   std::size_t overreaching = 0;
   const scallop::Rotation3 back = scallop::transpose(map.toPoleFrame);

@@ -35,12 +35,12 @@
 //         Every curve (cell edges, arcs) is sampled so that the straight polygon edges in the
 //         pole frame's plane (for n and for -n) stay within delta of it (an edge between
 //         two regular cells of one sheet, which cancels, at its ends alone); neighbouring
-//         cells share their edges' vertices exactly. The parts of one patch with one sign of K (a
-//         sheet, all of one orientation) are merged by cancelling shared edges; Boost.Polygon
-//         then unites the sheets, the hulls and the cells whose image holds the pole (the
-//         outside of their projected boundary, decided by the membership test below) on an
-//         integer grid of 2^29 steps across the pole cell's loop, and the complement is what
-//         remains inside that loop. The pole is the centre normal of the largest regular
+//         cells share their edges' vertices exactly. The parts of one patch with one sign of
+//         K (a sheet, all of one orientation) are merged by cancelling shared edges;
+//         Boost.Polygon then unites the sheets, the hulls and the cells whose image holds the
+//         pole (the outside of their projected boundary, decided by the membership test
+//         below) on an integer grid of 2^29 steps across the pole cell's loop, and the
+//         complement is what remains inside that loop. The pole is the centre normal of the largest regular
 //         cell; a traced cell that might hold it is subdivided instead.
 // Thin images: beside a parabolic line a part's image can be thinner than delta (a crescent
 //         between the fold's image and an edge's, tangent where they meet; a spike where the
@@ -116,6 +116,7 @@ struct GaussMap {
   std::size_t tracedCells = 0;       ///< quadtree cells where a parabolic arc was traced
   std::size_t foldCells = 0;         ///< small fold cells (normals within the tolerance)
   std::size_t untracedCells = 0;     ///< traced cells whose edges did not show the arc's ends
+                                     ///< (subdivided and run again; over every run)
   std::size_t reversedLobes = 0;     ///< twisted lobes of parts beside parabolic lines, added
   std::size_t candidatePieces = 0;   ///< cell images united (all curved patches)
   std::size_t membershipTests = 0;   ///< always 0: the union needs no membership tests
