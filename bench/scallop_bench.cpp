@@ -99,7 +99,9 @@ void BM_BruteForceEnvelope(benchmark::State& state) {
 //                                     segments (issue item 7: 5e-7 degree on both surfaces;
 //                                     one iteration, about ten seconds); counters: segments,
 //                                     alpha_deg; BM_GaussMap and BM_OrientMedialAxis at the
-//                                     same tolerance for its breakdown
+//                                     same tolerance for its breakdown, and BM_OrientCircle
+//                                     for the whole medial-axis search (coarse to fine, and
+//                                     on the full domain: _full)
 // and its stages alone, at the default tolerance, for the breakdown (the polish and eq 13 are
 // BM_OrientNoCertificate less BM_GaussMap less BM_OrientMedialAxis):
 //   BM_GaussMap/<surface>             the symmetrized Gauss map
@@ -183,6 +185,32 @@ void BM_OrientMedialAxis(benchmark::State& state, const char* name, double toler
   state.counters["segments"] = static_cast<double>(segments);
 }
 
+// The medial-axis search alone (bestCircles: the medial axis, eq 13 along its edges, the
+// rivals within 4 tolerances) on the same Gauss map as BM_OrientMedialAxis: coarse to fine
+// (the pipeline's default) or on the full-resolution domain. Counters: the fine segments,
+// those of the final domain searched, the refinement rounds, alpha of the best circle.
+void BM_OrientCircle(benchmark::State& state, const char* name, double toleranceDeg, bool coarseToFine) {
+  scallop::GaussMapOptions options;
+  options.toleranceRad = toleranceDeg * kDegree;
+  scallop::PlanarDomain domain;
+  domain.loops = scallop::symmetrizedGaussMap(scallop::exampleSurface(name), options).loops;
+  scallop::BestCirclesOptions search;
+  search.windowRad = 4.0 * options.toleranceRad;
+  search.coarseToFine = coarseToFine;
+  scallop::BestCircles result;
+  for (auto _ : state) {
+    result = scallop::bestCircles(domain, search);
+    double alpha = result.best.alphaRad;  // a copy: see BM_OrientFine
+    benchmark::DoNotOptimize(alpha);
+  }
+  std::size_t segments = 0;
+  for (const auto& loop : domain.loops) segments += loop.size();
+  state.counters["segments"] = static_cast<double>(segments);
+  state.counters["searched"] = static_cast<double>(result.segments);
+  state.counters["refinements"] = result.refinements;
+  state.counters["alpha_deg"] = result.best.alphaRad / kDegree;
+}
+
 // The medial axis (Boost.Polygon's Voronoi diagram, validated) of a wavy annulus with
 // range(0) boundary segments in all: the size the issue asks the pipeline to reach.
 void BM_MedialAxis(benchmark::State& state) {
@@ -225,6 +253,10 @@ BENCHMARK_CAPTURE(BM_GaussMap, paper1_100k, "paper-1", 5e-7)->Iterations(1)->Uni
 BENCHMARK_CAPTURE(BM_GaussMap, paper2_100k, "paper-2", 5e-7)->Iterations(1)->Unit(benchmark::kSecond);
 BENCHMARK_CAPTURE(BM_OrientMedialAxis, paper1_100k, "paper-1", 5e-7)->Iterations(1)->Unit(benchmark::kSecond);
 BENCHMARK_CAPTURE(BM_OrientMedialAxis, paper2_100k, "paper-2", 5e-7)->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(BM_OrientCircle, paper1_100k, "paper-1", 5e-7, true)->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(BM_OrientCircle, paper2_100k, "paper-2", 5e-7, true)->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(BM_OrientCircle, paper1_100k_full, "paper-1", 5e-7, false)->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(BM_OrientCircle, paper2_100k_full, "paper-2", 5e-7, false)->Iterations(1)->Unit(benchmark::kSecond);
 BENCHMARK(BM_MedialAxis)->Arg(1000)->Arg(10000)->Arg(100000)->Unit(benchmark::kMillisecond);
 
 BENCHMARK(BM_ScallopHull)->RangeMultiplier(2)->Range(1 << 10, 1 << 23)->Unit(benchmark::kMillisecond);

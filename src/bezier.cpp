@@ -83,6 +83,42 @@ Vec3 partial(const BezierPatch& patch, double u, double v, int du, int dv) {
   return (fallingFactorial(m, du) * fallingFactorial(n, dv)) * deCasteljau(net, m - du, u);
 }
 
+// B_j^d(t), dB_j^d/dt and d2B_j^d/dt2 for j = 0..d: the basis of degree d - 2 by the
+// triangle b^e_j = (1 - t) b^(e-1)_j + t b^(e-1)_(j-1), raised to d - 1 and d, with
+//   d/dt B_j^d = d (B_(j-1)^(d-1) - B_j^(d-1)),
+//   d2/dt2 B_j^d = d (d - 1) (B_(j-2)^(d-2) - 2 B_(j-1)^(d-2) + B_j^(d-2))
+// (terms with an index outside 0..degree are 0).
+struct BasisDerivatives {
+  std::vector<double> value, first, second;
+};
+BasisDerivatives basisDerivatives(int d, double t) {
+  std::vector<double> b{1.0};
+  std::vector<double> lower2, lower1;
+  for (int e = 1; e <= d; ++e) {
+    if (e == d - 1) lower2 = b;
+    if (e == d) lower1 = b;
+    std::vector<double> next(static_cast<std::size_t>(e) + 1, 0.0);
+    for (int j = 0; j <= e; ++j) {
+      const double keep = j < e ? (1.0 - t) * b[static_cast<std::size_t>(j)] : 0.0;
+      const double rise = j > 0 ? t * b[static_cast<std::size_t>(j - 1)] : 0.0;
+      next[static_cast<std::size_t>(j)] = keep + rise;
+    }
+    b = std::move(next);
+  }
+  if (d == 1) lower2.clear(), lower1 = {1.0};
+  if (d == 0) lower1.clear();
+  auto at = [](const std::vector<double>& c, int j) {
+    return j >= 0 && j < static_cast<int>(c.size()) ? c[static_cast<std::size_t>(j)] : 0.0;
+  };
+  BasisDerivatives out{b, std::vector<double>(b.size()), std::vector<double>(b.size())};
+  for (int j = 0; j <= d; ++j) {
+    const auto i = static_cast<std::size_t>(j);
+    out.first[i] = d * (at(lower1, j - 1) - at(lower1, j));
+    out.second[i] = d * (d - 1) * (at(lower2, j - 2) - 2.0 * at(lower2, j - 1) + at(lower2, j));
+  }
+  return out;
+}
+
 BezierPatch fromCoordinates(const std::array<Bernstein2, 3>& xyz) {
   BezierPatch patch{xyz[0].degreeU, xyz[0].degreeV, std::vector<Vec3>(xyz[0].coefficients.size())};
   for (std::size_t i = 0; i < patch.control.size(); ++i) {
@@ -229,6 +265,38 @@ Bernstein2 gaussianCurvatureNumerator(const BezierPatch& patch) {
 Bernstein2 normalLengthSquared(const BezierPatch& patch) {
   const std::array<Bernstein2, 3> normal = normalPolynomials(patch);
   return dot(normal, normal);
+}
+
+PatchDerivatives derivativesToSecondOrder(const BezierPatch& patch, double u, double v) {
+  const BasisDerivatives bu = basisDerivatives(patch.degreeU, u);
+  const BasisDerivatives bv = basisDerivatives(patch.degreeV, v);
+  PatchDerivatives out{};
+  for (int j = 0; j <= patch.degreeU; ++j) {
+    const auto ju = static_cast<std::size_t>(j);
+    Vec3 row0{}, row1{}, row2{};  // the row's sums with the v basis and its derivatives
+    for (int k = 0; k <= patch.degreeV; ++k) {
+      const auto kv = static_cast<std::size_t>(k);
+      const Vec3& p = patch.at(j, k);
+      row0 = row0 + bv.value[kv] * p;
+      row1 = row1 + bv.first[kv] * p;
+      row2 = row2 + bv.second[kv] * p;
+    }
+    out.u = out.u + bu.first[ju] * row0;
+    out.v = out.v + bu.value[ju] * row1;
+    out.uu = out.uu + bu.second[ju] * row0;
+    out.uv = out.uv + bu.first[ju] * row1;
+    out.vv = out.vv + bu.value[ju] * row2;
+  }
+  return out;
+}
+
+double gaussianCurvatureNumeratorAt(const BezierPatch& patch, double u, double v) {
+  const PatchDerivatives d = derivativesToSecondOrder(patch, u, v);
+  const Vec3 n = cross(d.u, d.v);
+  const double l = dot(d.uu, n);
+  const double m = dot(d.uv, n);
+  const double nn = dot(d.vv, n);
+  return l * nn - m * m;
 }
 
 }  // namespace scallop

@@ -7,9 +7,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <functional>
 #include <limits>
 #include <map>
+#include <optional>
 #include <set>
 #include <tuple>
 #include <unordered_map>
@@ -39,6 +41,10 @@ struct PatchData {
   std::array<Bernstein2, 3> normal;  // r_u x r_v, exact Bernstein form
   Bernstein2 curvature;              // Gaussian curvature numerator (sign of K)
   bool developable = false;          // K = 0 identically (to rounding)
+  // Patch edges v = 0, u = 1, v = 1, u = 0 that another patch may share or touch (a seam):
+  // there two patches' polygons of one curve must both be within the tolerance, or the
+  // sliver between them would open a gap in Omega (see BoundaryBand).
+  std::array<bool, 4> seam{false, false, false, false};
 };
 
 PatchData makePatchData(const BezierPatch& patch) {
@@ -69,6 +75,43 @@ PatchData makePatchData(const BezierPatch& patch) {
   for (double c : data.curvature.coefficients) largest = std::max(largest, std::abs(c));
   data.developable = largest <= 1e-12 * std::max(1e-300, nScale * nScale * second * second);
   return data;
+}
+
+// PatchData::seam: an edge whose control points' box, grown by 1e-9 of the surface's size,
+// meets another patch's box (conservative: edges that merely come near count too).
+void markSeams(std::vector<PatchData>& patches) {
+  if (patches.size() < 2) return;
+  struct Box {
+    Vec3 lo{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+            std::numeric_limits<double>::infinity()};
+    Vec3 hi = -lo;
+    void add(const Vec3& p) {
+      lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+      hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+    }
+    bool meets(const Box& o, double slack) const {
+      return lo.x <= o.hi.x + slack && o.lo.x <= hi.x + slack && lo.y <= o.hi.y + slack &&
+             o.lo.y <= hi.y + slack && lo.z <= o.hi.z + slack && o.lo.z <= hi.z + slack;
+    }
+  };
+  std::vector<Box> boxes(patches.size());
+  Box all;
+  for (std::size_t i = 0; i < patches.size(); ++i) {
+    for (const Vec3& p : patches[i].patch->control) boxes[i].add(p), all.add(p);
+  }
+  const double slack = 1e-9 * norm(all.hi - all.lo);
+  for (std::size_t i = 0; i < patches.size(); ++i) {
+    const BezierPatch& p = *patches[i].patch;
+    const int m = p.degreeU, n = p.degreeV;
+    std::array<Box, 4> edges;  // v = 0, u = 1, v = 1, u = 0
+    for (int j = 0; j <= m; ++j) edges[0].add(p.at(j, 0)), edges[2].add(p.at(j, n));
+    for (int k = 0; k <= n; ++k) edges[3].add(p.at(0, k)), edges[1].add(p.at(m, k));
+    for (std::size_t e = 0; e < 4; ++e) {
+      for (std::size_t other = 0; other < patches.size(); ++other) {
+        if (other != i && edges[e].meets(boxes[other], slack)) patches[i].seam[e] = true;
+      }
+    }
+  }
 }
 
 Bernstein2 combine(const std::array<Bernstein2, 3>& n, const Vec3& w) {
@@ -196,6 +239,73 @@ bool inOmega(const std::vector<PatchData>& patches, const Vec3& m) {
 // Normal curves, sampled to the tolerance where the polygon is used.
 // ---------------------------------------------------------------------------------------
 
+// Where Omega's boundary can lie, from a coarse map: the unit normals within `width` of
+// its polygon (on the sphere; chords stand for angles, which they match to 1e-6 at these
+// sizes). A curve of normals farther than that from the coarse boundary lies deep inside
+// Omega, and its polygon may be as coarse as that map's (see symmetrizedGaussMap). A uniform
+// grid of cells of side `reach` holds each boundary segment in every cell its box, grown by
+// `reach`, meets, so one cell answers a query about any point in it.
+class BoundaryBand {
+ public:
+  BoundaryBand(const std::vector<std::vector<Vec3>>& curves, double width)
+      : width_(width), reach_(width + kMaxChord) {
+    for (const auto& curve : curves) {
+      for (std::size_t i = 0; i + 1 < curve.size(); ++i) {
+        const Vec3 a = curve[i], b = curve[i + 1];
+        const auto index = static_cast<std::uint32_t>(a_.size());
+        a_.push_back(a);
+        b_.push_back(b);
+        const std::array<std::int64_t, 3> lo = cellOf(Vec3{std::min(a.x, b.x), std::min(a.y, b.y), std::min(a.z, b.z)} - Vec3{reach_, reach_, reach_});
+        const std::array<std::int64_t, 3> hi = cellOf(Vec3{std::max(a.x, b.x), std::max(a.y, b.y), std::max(a.z, b.z)} + Vec3{reach_, reach_, reach_});
+        for (std::int64_t x = lo[0]; x <= hi[0]; ++x) {
+          for (std::int64_t y = lo[1]; y <= hi[1]; ++y) {
+            for (std::int64_t z = lo[2]; z <= hi[2]; ++z) cells_[key({x, y, z})].push_back(index);
+          }
+        }
+      }
+    }
+  }
+
+  // Whether the curve piece sampled at n0, nm (its middle) and n1, or its antipode, may come
+  // within the width of the boundary: judged at the middle with the chord's length added
+  // (a piece longer than kMaxChord counts as near, to be halved further).
+  bool near(const Vec3& n0, const Vec3& nm, const Vec3& n1) const {
+    const double chord = std::max(norm(n0 - nm), norm(n1 - nm));
+    if (chord > kMaxChord) return true;
+    return within(nm, width_ + chord) || within(-nm, width_ + chord);
+  }
+
+ private:
+  static constexpr double kMaxChord = 0.05;
+
+  std::array<std::int64_t, 3> cellOf(const Vec3& p) const {
+    return {static_cast<std::int64_t>(std::floor(p.x / reach_)),
+            static_cast<std::int64_t>(std::floor(p.y / reach_)),
+            static_cast<std::int64_t>(std::floor(p.z / reach_))};
+  }
+  static std::int64_t key(const std::array<std::int64_t, 3>& c) {
+    // The three indices mixed into one key: a collision only costs extra distance tests.
+    return (c[0] * 73856093) ^ (c[1] * 19349663) ^ (c[2] * 83492791);
+  }
+  bool within(const Vec3& p, double distance) const {
+    const auto it = cells_.find(key(cellOf(p)));
+    if (it == cells_.end()) return false;
+    for (std::uint32_t i : it->second) {
+      const Vec3 d = b_[i] - a_[i];
+      const double length2 = dot(d, d);
+      double t = length2 > 0.0 ? dot(p - a_[i], d) / length2 : 0.0;
+      t = std::clamp(t, 0.0, 1.0);
+      if (norm(p - (a_[i] + t * d)) <= distance) return true;
+    }
+    return false;
+  }
+
+  double width_;
+  double reach_;
+  std::vector<Vec3> a_, b_;
+  std::unordered_map<std::int64_t, std::vector<std::uint32_t>> cells_;
+};
+
 // Samples normal curves n(s), s in [0, 1] (along a cell edge or a patch boundary), by
 // halving until the polygon is within `tol` of the curve and no segment spans more than
 // `maxStep` (so that a wiggle between samples is not missed). The polygon is used as
@@ -212,6 +322,9 @@ bool inOmega(const std::vector<PatchData>& patches, const Vec3& m) {
 struct NormalSampler {
   double tol;
   Rotation3 toPoleFrame;
+  // Optional: away from `band` (deep inside Omega) the polygon is held within `coarseTol`.
+  const BoundaryBand* band = nullptr;
+  double coarseTol = 0.0;
 
   double maxStep() const { return std::max(64.0 * tol, 0.05); }
 
@@ -245,7 +358,8 @@ struct NormalSampler {
               std::vector<double>* parameters) const {
     const double sm = 0.5 * (s0 + s1);
     const Vec3 nm = normalAt(sm);
-    const bool flat = angleBetween(n0, n1) <= maxStep() && deviation(n0, nm, n1) <= tol;
+    const double limit = band != nullptr && !band->near(n0, nm, n1) ? coarseTol : tol;
+    const bool flat = angleBetween(n0, n1) <= maxStep() && deviation(n0, nm, n1) <= limit;
     if (flat || depth >= 40) {
       out.push_back(n1);
       if (parameters != nullptr) parameters->push_back(s1);
@@ -283,6 +397,15 @@ struct NormalSampler {
 // ---------------------------------------------------------------------------------------
 
 constexpr double kRegularCellSpread = 0.5;  // radians
+
+// The coarse map of the band (see symmetrizedGaussMap): its tolerance (radians), used when
+// the tolerance asked for is at least kCoarseBandFactor times finer; the band's half-width
+// in coarse tolerances. The coarse boundary lies within its tolerance of the true one and a
+// curve's coarse polygon within it of the curve: a curve farther than 4 coarse tolerances
+// from the coarse boundary keeps a margin of 2 from the true one.
+constexpr double kCoarseToleranceRad = 2e-4;
+constexpr double kCoarseBandFactor = 16.0;
+constexpr double kBandWidthTolerances = 4.0;
 
 // A part of a cell where K keeps one sign: the image of its boundary, a loop (the image
 // is the region it bounds, with the orientation of that sign).
@@ -464,12 +587,7 @@ struct CellBuilder {
   // The Gaussian curvature numerator (r_uu . N)(r_vv . N) - (r_uv . N)^2 at (u, v), from the
   // patch's derivatives: the polynomial `data.curvature`, evaluated cheaply.
   double curvatureAt(double u, double v) const {
-    const BezierPatch& p = *data.patch;
-    const Vec3 n = normalVector(p, u, v);
-    const double l = dot(secondDerivative(p, u, v, 2, 0), n);
-    const double m = dot(secondDerivative(p, u, v, 1, 1), n);
-    const double nn = dot(secondDerivative(p, u, v, 0, 2), n);
-    return l * nn - m * m;
+    return gaussianCurvatureNumeratorAt(*data.patch, u, v);
   }
 
   // The root of K on the segment from p0 to p1, where K has opposite signs f0 and f1 at the
@@ -543,6 +661,30 @@ struct CellBuilder {
       out.signs.push_back(signOf(values[i]));
       out.where.push_back(pointAt(parameters[i]));
     }
+    return out;
+  }
+
+  // The piece from a to b at its ends alone, with its crossing of a parabolic line between
+  // them when K's signs there differ (a traced cell's edge has at most one root, see
+  // traceAxis; a regular cell's none): for pieces inside the sheets (see images).
+  EdgeSamples sampleEnds(UV a, UV b, int knownSign) const {
+    EdgeSamples out;
+    const double ka = knownSign != 0 ? knownSign : curvatureAt(a.u, a.v);
+    const double kb = knownSign != 0 ? knownSign : curvatureAt(b.u, b.v);
+    auto signOf = [](double k) -> signed char { return k > 0.0 ? 1 : (k < 0.0 ? -1 : 0); };
+    out.normals.push_back(normalAt(a.u, a.v));
+    out.signs.push_back(signOf(ka));
+    out.where.push_back(a);
+    if (ka * kb < 0.0) {
+      const double t = curvatureRoot(a, b, ka, kb);
+      const UV root{a.u + t * (b.u - a.u), a.v + t * (b.v - a.v)};
+      out.normals.push_back(normalAt(root.u, root.v));
+      out.signs.push_back(0);
+      out.where.push_back(root);
+    }
+    out.normals.push_back(normalAt(b.u, b.v));
+    out.signs.push_back(signOf(kb));
+    out.where.push_back(b);
     return out;
   }
 
@@ -661,8 +803,8 @@ struct CellBuilder {
   // The cells' images, their edges sampled by `sampler` (whose frame is the pole's).
   // `untraceable` receives the traced cells whose edges did not show their arc's two ends
   // (rounding at a crossing), to be subdivided in a new run.
-  std::vector<CellImage> images(const NormalSampler& sampler, ImageStats& stats,
-                                std::vector<CellBounds>& untraceable) const {
+  std::vector<CellImage> images(const NormalSampler& sampler, const NormalSampler& inner,
+                                ImageStats& stats, std::vector<CellBounds>& untraceable) const {
     std::vector<std::pair<UV, UV>> arcs;
     for (const Cell& c : cells) stats.tracedCells += c.traceAxis != 0 ? 1 : 0;
     // Corners on every vertical line u = c and horizontal line v = c (dyadic: exact keys).
@@ -711,6 +853,11 @@ struct CellBuilder {
     auto key = [](const EdgePiece& e) {
       return std::array<double, 3>{e.alongU ? e.fixed : -1.0 - e.fixed, e.t0, e.t1};
     };
+    // A piece on a patch edge that may be a seam (see PatchData::seam).
+    auto onSeam = [&](const EdgePiece& e) {
+      if (e.fixed != 0.0 && e.fixed != 1.0) return false;
+      return e.alongU ? data.seam[e.fixed == 0.0 ? 0 : 2] : data.seam[e.fixed == 0.0 ? 3 : 1];
+    };
     // Which cells hold +-pole (see `avoid`), decided once: for their pieces' sampling below
     // and for the union, which takes such a cell's image as the outside of its loop.
     std::vector<std::array<bool, 2>> poleHeld(cells.size(), {false, false});
@@ -720,25 +867,31 @@ struct CellBuilder {
         poleHeld[i] = holds(c.u0, c.u1, c.v0, c.v1, c.centre, c.spread, *avoid);
       }
     }
-    // An edge piece shared by two regular cells of one sign, neither of which holds +-pole,
-    // lies inside their sheet: both cells run it, opposite ways, and mergeSheet cancels it
-    // whatever its polygon, the sliver between polygon and curve counting for one cell as
-    // much as against the other. Such a piece is sampled at its ends alone. (Most pieces
-    // are such at fine tolerances; a cell holding the pole keeps its image as the outside
-    // of its own loop, so its pieces are sampled to the tolerance.)
+    // An edge piece shared by two cells that both join their sheets (regular or traced,
+    // neither holding +-pole) lies inside those sheets: the two cells run it opposite ways,
+    // and each of its stretches of one sign of K (the whole piece, or the two sides of its
+    // one crossing) belongs to the same sheet in both, so mergeSheet cancels it whatever its
+    // polygon, the sliver between polygon and curve counting for one cell as much as against
+    // the other. Such a piece is sampled at its ends and crossing alone: only the patch
+    // boundary and the parabolic lines, which bound the sheets, are sampled to the tolerance.
+    // (Small fold cells may take the hull of their normals, and a cell holding the pole keeps
+    // its image as the outside of its own loop: their pieces are sampled to the tolerance.)
     struct PieceUse {
       int users = 0;
-      int sign = 0;  // the users' common interior sign, or 0
+      bool joinSheets = true;  // every user joins its sheet
+      int sign = 0;            // the users' common sign of K when all are regular, or 0
     };
     std::map<std::array<double, 3>, PieceUse> uses;
     std::vector<std::vector<EdgePiece>> cellPieces(cells.size());
     for (std::size_t i = 0; i < cells.size(); ++i) {
       const Cell& c = cells[i];
-      const int sign = c.fold || poleHeld[i][0] || poleHeld[i][1] ? 0 : c.curvatureSign;
+      const bool joins = (!c.fold || c.traceAxis != 0) && !poleHeld[i][0] && !poleHeld[i][1];
+      const int sign = c.fold ? 0 : c.curvatureSign;
       cellPieces[i] = edgePieces(c);
       for (const EdgePiece& e : cellPieces[i]) {
         PieceUse& use = uses[key(e)];
         use.sign = use.users == 0 || use.sign == sign ? sign : 0;
+        use.joinSheets = use.joinSheets && joins;
         ++use.users;
       }
     }
@@ -767,12 +920,10 @@ struct CellBuilder {
           const UV a = e.alongU ? UV{e.t0, e.fixed} : UV{e.fixed, e.t0};
           const UV b = e.alongU ? UV{e.t1, e.fixed} : UV{e.fixed, e.t1};
           const PieceUse& use = uses.at(pieceKey);
-          if (use.users == 2 && use.sign != 0) {
-            samples.normals = {normalAt(a.u, a.v), normalAt(b.u, b.v)};
-            samples.signs.assign(2, static_cast<signed char>(use.sign));
-            samples.where = {a, b};
+          if (use.users == 2 && use.joinSheets) {
+            samples = sampleEnds(a, b, use.sign);
           } else {
-            samples = sampleEdgeWithSigns(sampler, a, b, c.curvatureSign);
+            samples = sampleEdgeWithSigns(onSeam(e) ? sampler : inner, a, b, c.curvatureSign);
           }
           pieces.emplace(pieceKey, samples);
         }
@@ -787,7 +938,7 @@ struct CellBuilder {
       }
       if (c.fold) {
         std::pair<UV, UV> crossing;
-        image.parts = split(c, sampler, loop, signs, where, &crossing);
+        image.parts = split(c, inner, loop, signs, where, &crossing);
         if (image.parts.size() == 2) arcs.emplace_back(crossing.first, crossing.second);
         if (image.parts.empty() && c.traceAxis != 0) untraceable.push_back(boundsOf(c));
       }
@@ -932,18 +1083,16 @@ struct MergedSheet {
 };
 
 MergedSheet mergeSheet(const std::vector<IntPolygon>& cells) {
-  struct Key {
-    long long ax, ay, bx, by;
-    bool operator==(const Key&) const = default;
+  // Every edge under its undirected key (the lesser end first) with +1 when it runs from the
+  // lesser end, -1 when it runs back: sorted, each key's sum is its net multiplicity.
+  struct Edge {
+    IntPoint from, to;
+    int count;
   };
-  struct Hash {
-    std::size_t operator()(const Key& k) const {
-      std::size_t h = std::hash<long long>()(k.ax);
-      for (long long v : {k.ay, k.bx, k.by}) h = h * 1000003u ^ std::hash<long long>()(v);
-      return h;
-    }
+  auto less = [](const IntPoint& a, const IntPoint& b) {
+    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
   };
-  std::unordered_map<Key, int, Hash> count;
+  std::vector<Edge> edges;
   double orientation = 0.0;
   for (const IntPolygon& polygon : cells) {
     const std::vector<IntPoint> points(polygon.begin(), polygon.end());
@@ -952,44 +1101,53 @@ MergedSheet mergeSheet(const std::vector<IntPolygon>& cells) {
       const IntPoint& a = points[i];
       const IntPoint& b = points[(i + 1) % points.size()];
       if (a == b) continue;
-      const Key reverse{b.x(), b.y(), a.x(), a.y()};
-      auto it = count.find(reverse);
-      if (it != count.end() && it->second > 0) {
-        if (--it->second == 0) count.erase(it);
-      } else {
-        ++count[Key{a.x(), a.y(), b.x(), b.y()}];
-      }
+      edges.push_back(less(a, b) ? Edge{a, b, 1} : Edge{b, a, -1});
     }
   }
-  // Walk the remaining edges into loops.
-  std::unordered_map<long long, std::vector<IntPoint>> next;
-  auto id = [](const IntPoint& p) { return (static_cast<long long>(p.x()) << 32) ^ static_cast<unsigned int>(p.y()); };
-  for (const auto& [k, n] : count) {
-    for (int i = 0; i < n; ++i) {
-      next[id(IntPoint(static_cast<int>(k.ax), static_cast<int>(k.ay)))].push_back(
-          IntPoint(static_cast<int>(k.bx), static_cast<int>(k.by)));
+  auto byKey = [&](const Edge& e, const Edge& f) {
+    return less(e.from, f.from) || (e.from == f.from && less(e.to, f.to));
+  };
+  std::sort(edges.begin(), edges.end(), byKey);
+  // The directed edges left, one per unit of net multiplicity, sorted by their start.
+  std::vector<Edge> left;
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i;
+    int net = 0;
+    while (j < edges.size() && edges[j].from == edges[i].from && edges[j].to == edges[i].to) {
+      net += edges[j++].count;
     }
+    for (int k = 0; k < std::abs(net); ++k) {
+      left.push_back(net > 0 ? Edge{edges[i].from, edges[i].to, 0} : Edge{edges[i].to, edges[i].from, 0});
+    }
+    i = j;
   }
+  edges.clear();
+  std::sort(left.begin(), left.end(), [&](const Edge& e, const Edge& f) { return less(e.from, f.from); });
+  // Walk them into loops: from each unused edge, on along an unused edge leaving its end
+  // (count marks an edge used), until back at the start.
+  auto firstFrom = [&](const IntPoint& p) {
+    return std::lower_bound(left.begin(), left.end(), p,
+                            [&](const Edge& e, const IntPoint& q) { return less(e.from, q); });
+  };
+  auto unusedFrom = [&](const IntPoint& p) -> Edge* {
+    for (auto it = firstFrom(p); it != left.end() && it->from == p; ++it) {
+      if (it->count == 0) return &*it;
+    }
+    return nullptr;
+  };
   MergedSheet out;
   out.counterClockwise = orientation > 0.0;
-  for (auto& [start, targets] : next) {
-    while (!targets.empty()) {
-      std::vector<IntPoint> loop;
-      IntPoint from = targets.back();
-      targets.pop_back();
-      // `from` is the second point of an edge leaving `start`; follow until back at start.
-      loop.push_back(from);
-      for (std::size_t guard = 0; guard < count.size() * 2 + 8; ++guard) {
-        auto it = next.find(id(from));
-        if (it == next.end() || it->second.empty()) break;
-        from = it->second.back();
-        it->second.pop_back();
-        loop.push_back(from);
-        if (id(from) == start) break;
-      }
-      if (loop.size() < 3) continue;
-      out.loops.push_back(std::move(loop));
+  for (Edge& first : left) {
+    if (first.count != 0) continue;
+    first.count = 1;
+    std::vector<IntPoint> loop{first.to};
+    while (!(loop.back() == first.from)) {
+      Edge* next = unusedFrom(loop.back());
+      if (next == nullptr) break;
+      next->count = 1;
+      loop.push_back(next->to);
     }
+    if (loop.size() >= 3) out.loops.push_back(std::move(loop));
   }
   return out;
 }
@@ -1021,6 +1179,22 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
   GaussMap map;
   std::vector<PatchData> patches;
   for (const BezierPatch& p : surface.patches) patches.push_back(makePatchData(p));
+  markSeams(patches);
+
+  // At fine tolerances, a coarse map first: curves farther than a band around its boundary
+  // lie deep inside Omega, and their polygons need only its tolerance (see BoundaryBand and
+  // the contract). Pieces on seams are exempt: two patches' polygons of one curve, each
+  // within its own tolerance, leave a sliver between them that would be a gap in Omega.
+  const double coarseTol = kCoarseBandFactor * tol;
+  std::optional<BoundaryBand> band;
+  if (options.coarseBand && coarseTol <= kCoarseToleranceRad) {
+    GaussMapOptions coarseOptions = options;
+    coarseOptions.toleranceRad = kCoarseToleranceRad;
+    const GaussMap coarse = symmetrizedGaussMap(surface, coarseOptions);
+    if (coarse.kind == GaussMapKind::region) {
+      band.emplace(coarse.sphereCurves, kBandWidthTolerances * kCoarseToleranceRad);
+    }
+  }
 
   // The cells of every curved patch (a developable patch has no regular cell: its image is
   // the image of its boundary, a curve).
@@ -1055,6 +1229,8 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
   map.toPoleFrame = rotationTaking(map.pole, {0.0, 0.0, 1.0});
 
   const NormalSampler sampler{tol, map.toPoleFrame};
+  NormalSampler inner = sampler;  // for curves off the seams (see BoundaryBand)
+  if (band) inner.band = &*band, inner.coarseTol = kCoarseToleranceRad;
 
   // Cell images of every curved patch; the images of the developable patches' boundaries.
   // A patch is run again, with cells subdivided instead of traced, while some traced cell
@@ -1082,7 +1258,7 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
       }
       std::vector<CellBuilder::CellBounds> untraceable;
       stats = {};
-      images = builder.images(sampler, stats, untraceable);
+      images = builder.images(sampler, inner, stats, untraceable);
       imageStats.untracedCells += untraceable.size();  // over every run
       if (untraceable.empty()) break;
       builder.noTrace.insert(untraceable.begin(), untraceable.end());
@@ -1191,35 +1367,17 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
   // left when every edge shared by two of them (traversed once each way) cancels. Handing
   // Boost those few loops instead of thousands of cells makes the union cheap.
   std::map<std::tuple<const PatchData*, int, int>, std::vector<IntPolygon>> sheets;
-  std::size_t lobeCount = 0;
-  // A loop of normals (for n, or -n) into its sheet; for a part beside a parabolic line
-  // (`twists`), with its lobes of reversed winding added to Omega on their own. Such a part
-  // can have an image thinner than the tolerance: a crescent between the fold's image and
-  // an edge's, tangent where they meet, or a spike where the line runs close to a patch
-  // edge. The polygon's sides, each within the tolerance of its curve, may then cross, and
-  // the lobes they cut off wind the wrong way, cancelling normals in the sheet; between
-  // sides within the tolerance of the true image, the lobes keep Omega within it too. The
-  // Gauss map keeps the orientation of (u, v) where K > 0 (n = r_u x r_v) and reverses it
-  // where K < 0; the antipodal map and the stereographic projection from the north pole
-  // each reverse it: a part (counter-clockwise in (u, v)) maps to a polygon of orientation
-  // -sign(K) for n and sign(K) for -n.
+  // A loop of normals (for n, or -n) into its sheet. The Gauss map keeps the orientation of
+  // (u, v) where K > 0 (n = r_u x r_v) and reverses it where K < 0; the antipodal map and
+  // the stereographic projection from the north pole each reverse it: a part
+  // (counter-clockwise in (u, v)) maps to a polygon of orientation -sign(K) for n and
+  // sign(K) for -n.
   const auto addToSheet = [&](const CellImage& c, const std::vector<Vec3>& normals,
-                              int curvatureSign, double sign, bool twists) {
+                              int curvatureSign, double sign) {
     std::vector<Vec2> loop;
     loop.reserve(normals.size());
     for (const Vec3& n : normals) loop.push_back(project(sign * n));
-    IntPolygon polygon = toPolygon(loop);
-    if (twists) {
-      const bool counterClockwise = -sign * curvatureSign > 0.0;
-      IntPolygonSet lobes;
-      lobes.insert_vertex_sequence(polygon.begin(), polygon.end(),
-                                   counterClockwise ? bp::CLOCKWISE : bp::COUNTERCLOCKWISE, false);
-      std::vector<IntPolygon> pieces;
-      lobes.get(pieces);
-      for (const IntPolygon& piece : pieces) omega.insert(piece);
-      lobeCount += pieces.size();
-    }
-    sheets[{c.patch, curvatureSign, sign > 0.0 ? 1 : -1}].push_back(std::move(polygon));
+    sheets[{c.patch, curvatureSign, sign > 0.0 ? 1 : -1}].push_back(toPolygon(loop));
   };
   for (std::size_t i = 0; i < cells.size(); ++i) {
     const CellImage& c = cells[i];
@@ -1230,11 +1388,11 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
       // region minus the cell loop's inside (decided in CellBuilder::images).
       const bool holdsPole = c.holdsPole[sign > 0.0 ? 0 : 1];
       if (!holdsPole && !c.fold) {
-        addToSheet(c, c.normals, c.curvatureSign, sign, false);  // merged below
+        addToSheet(c, c.normals, c.curvatureSign, sign);  // merged below
         continue;
       }
       if (!holdsPole && !c.parts.empty()) {
-        for (const SheetPart& part : c.parts) addToSheet(c, part.normals, part.curvatureSign, sign, true);
+        for (const SheetPart& part : c.parts) addToSheet(c, part.normals, part.curvatureSign, sign);
         continue;
       }
       std::vector<Vec2> loop;
@@ -1250,19 +1408,30 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
       }
     }
   }
+  // Each sheet joins the union as the region where its merged loops wind either way
+  // (nonzero), formed on its own: the union sums windings, and one sheet's must not cancel
+  // another's. Beside a parabolic line a sheet can be thinner than the tolerance: a crescent
+  // between the fold's image and a patch edge's, tangent where they meet, or a spike where
+  // the line runs close to a patch edge. The polygons of the two curves, each within the
+  // tolerance of its curve, may then cross, and the lobes they cut off wind the wrong way.
+  // Outside the tolerance of the sheet's boundary curves the polygon's winding number is
+  // the curves' (the polygon is homotopic to them within that band), so the nonzero region
+  // differs from the true image only within the tolerance of those curves, all of which
+  // are normals: Omega's boundary stays within the tolerance, and no normal is cancelled.
   for (const auto& [unused, polygons] : sheets) {
-    // Each sheet is cleaned on its own (its regions of positive winding kept) before it
-    // joins the union, which sums windings: a region a sheet's twisted part winds the wrong
-    // way would otherwise cancel the lobe added for it above.
     const MergedSheet merged = mergeSheet(polygons);
     IntPolygonSet sheet;
+    IntPolygonSet reversed;
     for (const auto& loop : merged.loops) {
-      sheet.insert_vertex_sequence(loop.begin(), loop.end(),
-                                   merged.counterClockwise ? bp::COUNTERCLOCKWISE : bp::CLOCKWISE,
-                                   false);
+      const bool ccw = merged.counterClockwise;
+      sheet.insert_vertex_sequence(loop.begin(), loop.end(), ccw ? bp::COUNTERCLOCKWISE : bp::CLOCKWISE, false);
+      reversed.insert_vertex_sequence(loop.begin(), loop.end(), ccw ? bp::CLOCKWISE : bp::COUNTERCLOCKWISE, false);
     }
-    sheet.clean();
-    omega.insert(sheet);
+    bp::arbitrary_boolean_op<int> nonzero;
+    IntPolygonSet filled;
+    nonzero.execute(filled, sheet.begin(), sheet.end(), reversed.begin(), reversed.end(),
+                    bp::arbitrary_boolean_op<int>::BOOLEAN_OR);
+    omega.insert(filled);
   }
   // A developable patch among curved ones: its normals form a curve (or a point) that may
   // lie outside the curved patches' region, and they are obstacles for the slicing
@@ -1330,11 +1499,15 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
     map.sphereCurves.push_back(std::move(onSphere));
   }
   map.candidatePieces = cells.size();
+  for (const CellImage& c : cells) {
+    map.imageVertices += c.normals.size();
+    for (const SheetPart& part : c.parts) map.imageVertices += part.normals.size();
+  }
   map.parabolicCurves = imageStats.parabolicLines;
   map.foldCells = foldCells;
   map.tracedCells = imageStats.tracedCells;
   map.untracedCells = imageStats.untracedCells;
-  map.reversedLobes = lobeCount;
+  map.coarseBandUsed = band.has_value();
   return map;
 }
 

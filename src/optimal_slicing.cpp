@@ -9,7 +9,10 @@
 #include <chrono>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <limits>
+#include <numbers>
+#include <numeric>
 #include <utility>
 #include <vector>
 
@@ -824,6 +827,427 @@ std::vector<std::vector<Vec2>> withoutSpikes(const std::vector<std::vector<Vec2>
   return out;
 }
 
+// ---------------------------------------------------------------------------------------
+// The medial-axis search (bestCircles), coarse to fine.
+
+// The coarse domain's target size, in segments: this times the square root of the fine
+// count. The search costs about two medial axes of the mixed domain, whose segments are the
+// coarse ones plus the fine chains of the few dozen coarse segments near the best circles
+// (each standing for fine / coarse fine segments): the sum is least near sqrt(dozens x fine).
+// On the paper's surfaces at ~100,000 segments: ~3,000 coarse ones, ~6,000-9,000 searched.
+constexpr double kCoarseSegmentsPerRootFine = 10.0;
+// Refinement rounds before the search gives up and takes the full-resolution domain.
+constexpr int kMaxRefinementRounds = 10;
+// Simplifications tried (delta halved each time) when the simplified loops cross (where the
+// domain is thinner than delta) before the full-resolution domain is taken.
+constexpr int kSimplificationAttempts = 3;
+
+double distanceToSegment(Vec2 p, Vec2 a, Vec2 b) {
+  const Vec2 d = b - a;
+  const double length2 = dot(d, d);
+  const double t = length2 > 0.0 ? std::clamp(dot(p - a, d) / length2, 0.0, 1.0) : 0.0;
+  return norm(p - (a + t * d));
+}
+
+// Every candidate circle of a medial axis, in edge order: each edge's ends and the roots of
+// eq (13) on it, where alpha along the edge has its extrema, so that edgeBestAlpha also
+// bounds alpha over the whole edge.
+struct AxisCandidates {
+  std::vector<RatedCircle> circles;
+  std::vector<double> edgeBestAlpha;  // per edge; -1: no usable circle on it
+  std::size_t best = 0;               // index into circles of the first greatest alpha
+};
+
+AxisCandidates rateCandidates(const MedialAxis& axis) {
+  AxisCandidates out;
+  out.edgeBestAlpha.assign(axis.edges.size(), -1.0);
+  for (std::size_t e = 0; e < axis.edges.size(); ++e) {
+    const MedialEdge& edge = axis.edges[e];
+    std::vector<double> ts = stationaryParameters(edge);
+    ts.push_back(0.0);
+    ts.push_back(1.0);
+    for (double t : ts) {
+      const Vec2 c = pointAt(edge, t);
+      const double r = radiusAt(edge, t);
+      const double rho = norm(c);
+      // Circles that hold the origin (the south pole, a surface normal's antipode) are not
+      // in the complement; the medial axis never yields them but rounding might.
+      if (!(r > 0.0) || rho <= r) {
+        // Rated as the best possible for the coarse-to-fine test, which then examines it.
+        if (r > 0.0) out.edgeBestAlpha[e] = std::numbers::pi;
+        continue;
+      }
+      const double alpha = alphaOfPlaneCircleRad(rho, r);  // eq (12)
+      if (out.circles.empty() || alpha > out.circles[out.best].alphaRad) out.best = out.circles.size();
+      out.circles.push_back({alpha, {c, r}});
+      out.edgeBestAlpha[e] = std::max(out.edgeBestAlpha[e], alpha);
+    }
+  }
+  return out;
+}
+
+BestCircles searchResult(MedialAxis axis, const AxisCandidates& candidates, double windowRad) {
+  if (candidates.circles.empty()) throw Error("the medial axis of the Gauss map's complement has no usable circle");
+  BestCircles out;
+  out.best = candidates.circles[candidates.best];
+  for (const RatedCircle& c : candidates.circles) {
+    if (c.alphaRad >= out.best.alphaRad - windowRad) out.rivals.push_back(c);
+  }
+  std::stable_sort(out.rivals.begin(), out.rivals.end(),
+                   [](const RatedCircle& a, const RatedCircle& b) { return a.alphaRad > b.alphaRad; });
+  out.axis = std::move(axis);
+  return out;
+}
+
+std::size_t segmentCount(const PlanarDomain& domain) {
+  std::size_t n = 0;
+  for (const auto& loop : domain.loops) n += loop.size();
+  return n;
+}
+
+std::vector<std::uint32_t> douglasPeucker(const std::vector<Vec2>& loop, double delta);
+
+// The Douglas-Peucker tolerance delta that leaves about kCoarseSegmentsPerRootFine x
+// sqrt(fine) coarse segments: one trial at 1e-6 of the bounding box's diagonal, then the
+// count's law on smooth curves (a chord of sagitta delta spans a length proportional to
+// sqrt(delta), so the count goes as delta^-1/2), within a factor 100 of the trial.
+double simplificationTolerance(const PlanarDomain& domain) {
+  Vec2 low{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+  Vec2 high = -low;
+  std::size_t fine = 0;
+  for (const auto& loop : domain.loops) {
+    fine += loop.size();
+    for (const Vec2& p : loop) {
+      low = {std::min(low.x, p.x), std::min(low.y, p.y)};
+      high = {std::max(high.x, p.x), std::max(high.y, p.y)};
+    }
+  }
+  const double trial = 1e-6 * norm(high - low);
+  if (!std::isfinite(trial) || !(trial > 0.0)) return 0.0;
+  std::size_t coarse = 0;
+  for (const auto& loop : domain.loops) {
+    if (loop.size() >= 3) coarse += douglasPeucker(loop, trial).size();
+  }
+  const double target = kCoarseSegmentsPerRootFine * std::sqrt(static_cast<double>(fine));
+  const double ratio = static_cast<double>(std::max<std::size_t>(coarse, 1)) / target;
+  return trial * std::clamp(ratio * ratio, 1e-2, 1e2);
+}
+
+// Douglas-Peucker on a closed loop: the indices (increasing, starting with 0) of the
+// vertices kept so that every vertex between two consecutive kept ones lies within `delta`
+// of the segment joining them. Vertex 0 and the loop's extreme vertices in x and y are
+// always kept, so that the simplified domain has the same bounding box, hence the same
+// integer grid in medialAxis (medial_axis.hpp), as the full one: the vertices they share are
+// quantised alike and the circles they define come out bit for bit. Iterative (explicit
+// stack); O(n log n) on smooth loops, where the farthest vertex splits a chain near its
+// middle.
+std::vector<std::uint32_t> douglasPeucker(const std::vector<Vec2>& loop, double delta) {
+  const std::size_t n = loop.size();
+  if (n < 3) {
+    std::vector<std::uint32_t> all(n);
+    std::iota(all.begin(), all.end(), 0U);
+    return all;
+  }
+  std::vector<char> keep(n, 0);
+  std::array<std::size_t, 5> anchors{0, 0, 0, 0, 0};
+  for (std::size_t i = 1; i < n; ++i) {
+    if (loop[i].x < loop[anchors[1]].x) anchors[1] = i;
+    if (loop[i].x > loop[anchors[2]].x) anchors[2] = i;
+    if (loop[i].y < loop[anchors[3]].y) anchors[3] = i;
+    if (loop[i].y > loop[anchors[4]].y) anchors[4] = i;
+  }
+  for (std::size_t a : anchors) keep[a] = 1;
+  std::vector<std::size_t> sorted(anchors.begin(), anchors.end());
+  std::sort(sorted.begin(), sorted.end());
+  sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
+  // Chains [first, last] in unrolled indices (last may be n, i.e. vertex 0 again).
+  std::vector<std::pair<std::size_t, std::size_t>> stack;
+  for (std::size_t k = 0; k < sorted.size(); ++k) {
+    stack.push_back({sorted[k], k + 1 < sorted.size() ? sorted[k + 1] : n});
+  }
+  while (!stack.empty()) {
+    const auto [first, last] = stack.back();
+    stack.pop_back();
+    if (last - first < 2) continue;
+    const Vec2 a = loop[first];
+    const Vec2 b = loop[last % n];
+    double farthest = -1.0;
+    std::size_t split = first;
+    for (std::size_t i = first + 1; i < last; ++i) {
+      const double d = distanceToSegment(loop[i], a, b);
+      if (d > farthest) farthest = d, split = i;
+    }
+    if (farthest <= delta) continue;
+    keep[split] = 1;
+    stack.push_back({first, split});
+    stack.push_back({split, last});
+  }
+  std::vector<std::uint32_t> kept;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (keep[i]) kept.push_back(static_cast<std::uint32_t>(i));
+  }
+  return kept;
+}
+
+// A uniform grid over segments for the verification's query: the segments that may lie
+// within distance `outer` of a point, skipping the cells wholly within distance `inner`
+// (inside an empty maximal disc, where no boundary lies). Cells are registered by each
+// segment's bounding box. A query costs O(rows + cells along the annulus).
+class SegmentGrid {
+ public:
+  SegmentGrid(const std::vector<std::array<Vec2, 2>>& segments, Vec2 low, Vec2 high) {
+    origin_ = low;
+    const double extent = std::max({high.x - low.x, high.y - low.y, 1e-300});
+    // About two cells per segment: the segments lie along curves, so most cells stay
+    // empty and an occupied one holds a few.
+    const double side = std::clamp(std::ceil(std::sqrt(2.0 * static_cast<double>(segments.size()))), 1.0, 2048.0);
+    cell_ = extent / side;
+    columns_ = static_cast<int>(std::ceil((high.x - low.x) / cell_)) + 1;
+    rows_ = static_cast<int>(std::ceil((high.y - low.y) / cell_)) + 1;
+    start_.assign(static_cast<std::size_t>(columns_) * static_cast<std::size_t>(rows_) + 1, 0);
+    auto forCells = [this](const std::array<Vec2, 2>& s, auto&& f) {
+      const int i0 = column(std::min(s[0].x, s[1].x)), i1 = column(std::max(s[0].x, s[1].x));
+      const int j0 = row(std::min(s[0].y, s[1].y)), j1 = row(std::max(s[0].y, s[1].y));
+      for (int j = j0; j <= j1; ++j)
+        for (int i = i0; i <= i1; ++i) f(index(i, j));
+    };
+    for (const auto& s : segments) forCells(s, [this](std::size_t c) { ++start_[c + 1]; });
+    for (std::size_t c = 1; c < start_.size(); ++c) start_[c] += start_[c - 1];
+    items_.resize(start_.back());
+    std::vector<std::uint32_t> fill(start_.begin(), start_.end() - 1);
+    for (std::size_t k = 0; k < segments.size(); ++k) {
+      forCells(segments[k], [&](std::size_t c) { items_[fill[c]++] = static_cast<std::uint32_t>(k); });
+    }
+  }
+
+  template <typename Visit>
+  void forEachNear(Vec2 p, double inner, double outer, Visit&& visit) const {
+    const int j0 = row(p.y - outer), j1 = row(p.y + outer);
+    for (int j = j0; j <= j1; ++j) {
+      const double ya = origin_.y + j * cell_, yb = ya + cell_;
+      const double dyMin = std::max({ya - p.y, 0.0, p.y - yb});
+      if (dyMin > outer) continue;
+      const double dyMax = std::max(std::abs(p.y - ya), std::abs(p.y - yb));
+      const double half = std::sqrt(outer * outer - dyMin * dyMin);
+      const int i0 = column(p.x - half), i1 = column(p.x + half);
+      // Columns [skip0, skip1] lie wholly within `inner` of p on this row.
+      int skip0 = i1 + 1, skip1 = i1;
+      if (inner > dyMax) {
+        const double w = std::sqrt(inner * inner - dyMax * dyMax);
+        skip0 = static_cast<int>(std::clamp(std::floor((p.x - w - origin_.x) / cell_) + 1.0, -1.0, double(columns_)));
+        skip1 = static_cast<int>(std::clamp(std::ceil((p.x + w - origin_.x) / cell_) - 2.0, -2.0, double(columns_)));
+      }
+      for (int i = i0; i <= i1; ++i) {
+        if (i >= skip0 && i <= skip1) {
+          i = skip1;
+          continue;
+        }
+        const std::size_t c = index(i, j);
+        for (std::uint32_t k = start_[c]; k < start_[c + 1]; ++k) visit(items_[k]);
+      }
+    }
+  }
+
+ private:
+  int column(double x) const {
+    return static_cast<int>(std::clamp(std::floor((x - origin_.x) / cell_), 0.0, double(columns_ - 1)));
+  }
+  int row(double y) const {
+    return static_cast<int>(std::clamp(std::floor((y - origin_.y) / cell_), 0.0, double(rows_ - 1)));
+  }
+  std::size_t index(int i, int j) const {
+    return static_cast<std::size_t>(j) * static_cast<std::size_t>(columns_) + static_cast<std::size_t>(i);
+  }
+
+  Vec2 origin_;
+  double cell_ = 1.0;
+  int columns_ = 1;
+  int rows_ = 1;
+  std::vector<std::uint32_t> start_;  // CSR: cell c holds items_[start_[c], start_[c + 1])
+  std::vector<std::uint32_t> items_;
+};
+
+// The domain of the coarse-to-fine search: every loop simplified by Douglas-Peucker at
+// `delta`, each coarse segment standing for the fine chain between its two kept vertices,
+// and the "mixed" domain M in which the refined coarse segments are replaced by their
+// chains.
+//
+// Why M's optimum is the full domain F's (the test in violations()). Every fine vertex of a
+// chain lies within delta of its coarse segment, hence so does the whole chain, and every
+// point of the segment lies within delta of the chain (the chain's projection onto the
+// segment covers it), so M and F differ only inside the delta-neighbourhoods of the
+// unrefined coarse segments. The stereographic projection's conformal factor is
+// 2 / (1 + |p|^2) <= 2: moving a circle's boundary by delta in the plane changes its cap's
+// angular radius alpha by at most 2 delta (and alpha <= 2R). Let C* be an optimal (or
+// rival) circle of F, with alpha* > 4 delta, so its centre is not within delta of an
+// unrefined coarse segment and lies in M. C* shrunk by delta avoids M's boundary, so lies in
+// M, hence in a maximal disc D of M, centred on M's medial axis, with
+// alpha(D) >= alpha(C*) - 2 delta. The test: every point of M's axis whose circle has
+// alpha >= alpha_M - window - 3 delta (2 delta, and delta for rounding) is farther than
+// R + 2 delta from every unrefined coarse segment. Along each edge, alpha is monotone between
+// the roots of eq (13), so the parts above that threshold are intervals (found by
+// bisection); on them g(t) = dist(c(t), unrefined) - R(t), 2-Lipschitz in arc length, is
+// sampled from one end to the other, each sample covering the arc length
+// (g - 2 delta - rounding) / 2 ahead of it; a sample that covers less than h / 2 (h = delta)
+// fails, and the coarse segments within R + 2 delta + h of it are refined. If no sample
+// fails, C* (within delta of D) stays more than delta from every unrefined segment, so it
+// touches only refined parts (common to M and F) and is a maximal disc of M:
+// alpha_M >= alpha*. Conversely M's best circle and rivals pass the test, so they are empty
+// maximal discs of F touching the same sites (and alpha* >= alpha_M > 5 delta, as assumed).
+// Hence alpha_M = alpha*, and the circles within the window of it are the same in M and F,
+// up to the rounding of the roots of eq (13) on edges of different extent: bit for bit in
+// practice, as M's refined vertices are F's, on the same integer grid (see douglasPeucker),
+// unless Boost's diagram of one of them fails validation and is rebuilt rotated (then the
+// two agree to the medial axis's tolerance).
+class CoarseToFineDomain {
+ public:
+  CoarseToFineDomain(const PlanarDomain& fine, double delta) : fine_(fine), delta_(delta) {
+    for (std::size_t l = 0; l < fine.loops.size(); ++l) {
+      const std::vector<Vec2>& loop = fine.loops[l];
+      if (loop.empty()) continue;
+      std::vector<std::uint32_t> kept = douglasPeucker(loop, delta);
+      // A loop that simplifies below a triangle is thinner than 2 delta: kept whole (and a
+      // degenerate one left for medialAxis to explain).
+      const bool whole = kept.size() < 3;
+      for (std::size_t k = 0; k < kept.size(); ++k) {
+        const std::uint32_t last = k + 1 < kept.size() ? kept[k + 1] : static_cast<std::uint32_t>(loop.size());
+        segments_.push_back({static_cast<std::uint32_t>(l), kept[k], last, whole});
+      }
+    }
+  }
+
+  double delta() const { return delta_; }
+
+  // M: each loop's coarse segments, the refined ones replaced by their fine chains.
+  PlanarDomain mixed() const {
+    PlanarDomain out;
+    out.loops.resize(fine_.loops.size());
+    for (const Segment& s : segments_) {
+      const std::vector<Vec2>& loop = fine_.loops[s.loop];
+      std::vector<Vec2>& into = out.loops[s.loop];
+      into.push_back(loop[s.first]);
+      if (s.refined) into.insert(into.end(), loop.begin() + s.first + 1, loop.begin() + s.last);
+    }
+    return out;
+  }
+
+  // The unrefined coarse segments that fail the test above for M's axis and its candidates.
+  std::vector<std::size_t> violations(const MedialAxis& axis, const AxisCandidates& candidates,
+                                      double windowRad) const {
+    std::vector<std::size_t> ids;
+    std::vector<std::array<Vec2, 2>> coarse;
+    Vec2 low{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+    Vec2 high = -low;
+    for (std::size_t k = 0; k < segments_.size(); ++k) {
+      const Segment& s = segments_[k];
+      if (s.refined) continue;
+      const std::vector<Vec2>& loop = fine_.loops[s.loop];
+      const std::array<Vec2, 2> ab{loop[s.first], loop[s.last % loop.size()]};
+      for (const Vec2& p : ab) {
+        low = {std::min(low.x, p.x), std::min(low.y, p.y)};
+        high = {std::max(high.x, p.x), std::max(high.y, p.y)};
+      }
+      ids.push_back(k);
+      coarse.push_back(ab);
+    }
+    if (coarse.empty()) return {};
+    const SegmentGrid grid(coarse, low, high);
+    const double h = delta_;
+    // The axis is exact for the integer-rounded domain; its radii to within its tolerance.
+    const double clearance = 2.0 * delta_ + 4.0 * axis.tolerance;
+    const double threshold = candidates.circles[candidates.best].alphaRad - windowRad - 3.0 * delta_;
+    std::vector<char> violated(coarse.size(), 0);
+    // The test at one point of the axis: the arc length ahead of it in which g = dist - R
+    // stays above `clearance` (g is 2-Lipschitz), or, when that is below h/2, a failure: the
+    // segments closer than R + clearance + h are marked (which lets the march go on h/2).
+    auto clearAhead = [&](Vec2 c, double r) {
+      const double reach = std::max(h, std::min(0.25 * r, 64.0 * h));  // the longest stride sought
+      double nearest = r + clearance + 2.0 * reach;
+      grid.forEachNear(c, r - delta_, nearest, [&](std::uint32_t k) {
+        if (!violated[k]) nearest = std::min(nearest, distanceToSegment(c, coarse[k][0], coarse[k][1]));
+      });
+      const double ahead = 0.5 * (nearest - r - clearance);
+      if (ahead >= 0.5 * h) return ahead;
+      const double limit = r + clearance + h;
+      grid.forEachNear(c, r - delta_, limit, [&](std::uint32_t k) {
+        if (distanceToSegment(c, coarse[k][0], coarse[k][1]) <= limit) violated[k] = 1;
+      });
+      return 0.5 * h;
+    };
+    auto alphaAt = [](const MedialEdge& edge, double t) {
+      return alphaOfPlaneCircleRad(norm(pointAt(edge, t)), radiusAt(edge, t));
+    };
+    for (std::size_t e = 0; e < axis.edges.size(); ++e) {
+      if (candidates.edgeBestAlpha[e] < threshold) continue;
+      const MedialEdge& edge = axis.edges[e];
+      // |c'(t)| bounds the arc length per unit t: the control polygon's longest leg, doubled
+      // on a quadratic.
+      const auto& p = edge.control;
+      const double speed = edge.kind == MedialEdge::Kind::linear
+                               ? norm(p[1] - p[0])
+                               : 2.0 * std::max(norm(p[1] - p[0]), norm(p[2] - p[1]));
+      // alpha is monotone between consecutive roots of eq (13) (its derivative has the sign
+      // of that polynomial over R > 0), so {alpha >= threshold} is a union of intervals whose
+      // ends bisection finds; each is marched with the test above.
+      std::vector<double> ts = stationaryParameters(edge);
+      ts.push_back(0.0);
+      ts.push_back(1.0);
+      for (double& t : ts) t = std::clamp(t, 0.0, 1.0);
+      std::sort(ts.begin(), ts.end());
+      for (std::size_t k = 0; k + 1 < ts.size(); ++k) {
+        double lo = ts[k], hi = ts[k + 1];
+        const double alphaLo = alphaAt(edge, lo), alphaHi = alphaAt(edge, hi);
+        if (std::max(alphaLo, alphaHi) < threshold) continue;
+        if (std::min(alphaLo, alphaHi) < threshold) {
+          // Keep the bracket's end below the threshold: the interval only grows.
+          const bool rising = alphaLo < alphaHi;
+          double below = rising ? lo : hi, above = rising ? hi : lo;
+          for (int i = 0; i < 60 && std::abs(above - below) * speed > 0.25 * h; ++i) {
+            const double mid = 0.5 * (below + above);
+            (alphaAt(edge, mid) < threshold ? below : above) = mid;
+          }
+          (rising ? lo : hi) = below;
+        }
+        for (double t = lo;;) {
+          const double ahead = clearAhead(pointAt(edge, t), radiusAt(edge, t));
+          if (t >= hi || !(speed > 0.0)) break;
+          t = std::min(hi, t + ahead / speed);
+        }
+      }
+    }
+    std::vector<std::size_t> out;
+    for (std::size_t k = 0; k < coarse.size(); ++k) {
+      if (violated[k]) out.push_back(ids[k]);
+    }
+    return out;
+  }
+
+  // Replaces the given coarse segments, and their neighbours in their loops, by their fine
+  // chains. The neighbours: the circles move a little when their contacts are refined, and
+  // would otherwise often call for one more round (one medial axis of the whole mixed
+  // domain) for a segment or two.
+  void refine(const std::vector<std::size_t>& ids) {
+    for (std::size_t k : ids) {
+      segments_[k].refined = true;
+      const Segment& s = segments_[k];
+      if (k > 0 && segments_[k - 1].loop == s.loop) segments_[k - 1].refined = true;
+      if (k + 1 < segments_.size() && segments_[k + 1].loop == s.loop) segments_[k + 1].refined = true;
+    }
+  }
+
+ private:
+  struct Segment {
+    std::uint32_t loop = 0;
+    std::uint32_t first = 0;  // kept vertex where the segment starts
+    std::uint32_t last = 0;   // the next kept vertex (the loop's size for vertex 0)
+    bool refined = false;     // replaced by the fine chain first..last in M
+  };
+
+  const PlanarDomain& fine_;
+  double delta_;
+  std::vector<Segment> segments_;
+};
+
 }  // namespace
 
 bool certifyClearance(const Surface& surface, const Vec3& n, double lowerBoundRad,
@@ -841,6 +1265,55 @@ bool certifyClearance(const Surface& surface, const Vec3& n, double lowerBoundRa
     if (!provePositive(p, 0, maxDepth, cells)) return false;
   }
   return true;
+}
+
+BestCircles bestCircles(const PlanarDomain& domain, const BestCirclesOptions& options) {
+  if (!(options.windowRad >= 0.0) || !std::isfinite(options.windowRad)) {
+    throw Error(fmt::format("bestCircles: the window must be a finite angle >= 0, got {} rad", options.windowRad));
+  }
+  const std::size_t fineSegments = segmentCount(domain);
+  auto searchWhole = [&](int refinements) {
+    MedialAxis axis = medialAxis(domain);
+    const AxisCandidates candidates = rateCandidates(axis);
+    BestCircles out = searchResult(std::move(axis), candidates, options.windowRad);
+    out.segments = fineSegments;
+    out.refinements = refinements;
+    return out;
+  };
+  if (!options.coarseToFine || fineSegments <= options.coarseToFineMinSegments) return searchWhole(0);
+  const double delta = simplificationTolerance(domain);
+  if (!(delta > 0.0)) return searchWhole(0);  // degenerate input: medialAxis explains
+  int refinements = 0;
+  for (int attempt = 0; attempt < kSimplificationAttempts; ++attempt) {
+    CoarseToFineDomain coarse(domain, std::ldexp(delta, -attempt));
+    for (int round = 0;; ++round) {
+      const PlanarDomain mixed = coarse.mixed();
+      MedialAxis axis;
+      try {
+        axis = medialAxis(mixed);
+      } catch (const Error&) {
+        break;  // the simplified loops cross where the domain is thinner than delta
+      }
+      const AxisCandidates candidates = rateCandidates(axis);
+      // The proof needs alpha* > 4 delta (see CoarseToFineDomain); below that delta is as
+      // large as the circles, and the full domain is cheaper than refining everything.
+      if (candidates.circles.empty() || !(candidates.circles[candidates.best].alphaRad > 5.0 * coarse.delta())) {
+        return searchWhole(refinements);
+      }
+      const std::vector<std::size_t> violations = coarse.violations(axis, candidates, options.windowRad);
+      if (violations.empty()) {
+        BestCircles out = searchResult(std::move(axis), candidates, options.windowRad);
+        out.segments = segmentCount(mixed);
+        out.refinements = round;
+        out.simplificationTolerance = coarse.delta();
+        return out;
+      }
+      if (round + 1 >= kMaxRefinementRounds) return searchWhole(refinements);
+      coarse.refine(violations);
+      ++refinements;
+    }
+  }
+  return searchWhole(refinements);
 }
 
 OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOptions& options) {
@@ -881,42 +1354,30 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
     PlanarDomain domain;
     domain.loops = withoutSpikes(map.loops, 1e-2 * tol);
     if (domain.loops.empty()) throw Error("the complement of the Gauss map is empty: no slicing direction avoids every surface normal");
-    const MedialAxis axis = medialAxis(domain);
-    result.medialAxisEdges = axis.edges.size();
-    result.medialAxisRebuilds = axis.rebuilds;
-    double bestAlpha = -1.0;
-    std::vector<std::pair<double, PlaneCircle>> circles;  // every candidate, for rival basins
-    for (const MedialEdge& edge : axis.edges) {
+    BestCirclesOptions searchOptions;
+    // Rival basins: the polygon is within tol of Omega, so a circle within a few tol of the
+    // best may be the true optimum's.
+    searchOptions.windowRad = 4.0 * tol;
+    searchOptions.coarseToFine = options.coarseToFine;
+    const BestCircles search = bestCircles(domain, searchOptions);
+    result.medialAxisEdges = search.axis.edges.size();
+    result.medialAxisRebuilds = search.axis.rebuilds;
+    result.medialAxisSegments = search.segments;
+    result.medialAxisRefinements = search.refinements;
+    for (const MedialEdge& edge : search.axis.edges) {
       std::vector<Vec2> curve;
       const int samples = edge.kind == MedialEdge::Kind::linear ? 1 : 8;
       for (int i = 0; i <= samples; ++i) curve.push_back(pointAt(edge, static_cast<double>(i) / samples));
       result.medialAxisCurves.push_back(std::move(curve));
-      std::vector<double> ts = stationaryParameters(edge);
-      ts.push_back(0.0);
-      ts.push_back(1.0);
-      for (double t : ts) {
-        const Vec2 c = pointAt(edge, t);
-        const double r = radiusAt(edge, t);
-        const double rho = norm(c);
-        // Circles that hold the origin (the south pole, a surface normal's antipode) are not
-        // in the complement; the medial axis never yields them but rounding might.
-        if (!(r > 0.0) || rho <= r) continue;
-        const double alpha = alphaOfPlaneCircleRad(rho, r);  // eq (12)
-        circles.push_back({alpha, {c, r}});
-        if (alpha > bestAlpha) bestAlpha = alpha, result.circle = {c, r};
-      }
     }
-    if (bestAlpha < 0.0) throw Error("the medial axis of the Gauss map's complement has no usable circle");
+    result.circle = search.best.circle;
     result.alphaRad = alphaOfPlaneCircleRad(norm(result.circle.center), result.circle.radius);
     result.normal = apply(back, directionOfPlaneCircle(result.circle.center, result.circle.radius));
     result.sphereCircle = {result.normal, result.alphaRad};
-    // Rival basins: the polygon is within tol of Omega, so a circle within a few tol of the
-    // best may be the true optimum's. Keep up to four such, in distinct directions (more
-    // than a degree apart), to be polished below.
-    std::sort(circles.begin(), circles.end(),
-              [](const auto& a, const auto& b) { return a.first > b.first; });
-    for (const auto& [alpha, circle] : circles) {
-      if (alpha < bestAlpha - 4.0 * tol || rivals.size() >= 4) break;
+    // Keep up to four rivals, in distinct directions (more than a degree apart), to be
+    // polished below.
+    for (const auto& [alpha, circle] : search.rivals) {
+      if (rivals.size() >= 4) break;
       const Vec3 n = apply(back, directionOfPlaneCircle(circle.center, circle.radius));
       bool distinct = true;
       for (const Vec3& q : rivals) {

@@ -241,6 +241,28 @@ TEST(BezierEvaluate, PointAndDerivativesMatchExplicitSums) {
             ASSERT_TRUE(within(got, want, tolerance))
                 << "bidegree (" << m << ", " << n << "), order (" << a << ", " << b << ")";
             ++checks;
+            // The one-pass basis derivatives, to the same bound.
+            if (a + b >= 1) {
+              const scallop::PatchDerivatives d = scallop::derivativesToSecondOrder(p, u, v);
+              const Vec3 onePass = a == 1 && b == 0   ? d.u
+                                   : a == 0 && b == 1 ? d.v
+                                   : a == 2           ? d.uu
+                                   : a == 1           ? d.uv
+                                                      : d.vv;
+              // Its sums weigh the control points themselves (not their differences) by basis
+              // derivatives whose absolute values add up to at most 2^a m^a 2^b n^b.
+              V3 largest;
+              for (const Vec3& c : p.control) {
+                const V3 q = absL(toL(c));
+                largest = {std::max(largest.x, q.x), std::max(largest.y, q.y), std::max(largest.z, q.z)};
+              }
+              const V3 onePassTolerance =
+                  (gamma(3 * (m + n) + 8) * powInt(2.0L * m, a) * powInt(2.0L * n, b)) * largest +
+                  kRefFactor(m, n) * magnitude;
+              ASSERT_TRUE(within(onePass, want, onePassTolerance))
+                  << "one pass, bidegree (" << m << ", " << n << "), order (" << a << ", " << b << ")";
+              ++checks;
+            }
           }
           // The coordinate polynomials evaluate by the same de Casteljau steps: bit for bit.
           const Vec3 at = scallop::point(p, u, v);
@@ -471,6 +493,9 @@ TEST(BezierCurvature, NumeratorMatchesClassicalGaussianCurvature) {
       const Real tolerance = gamma(numeratorSteps(m, n)) * c.bound + c.referenceError;
       const double got = evaluate(numerator, u, v);
       ASSERT_LE(std::fabs(got - c.numerator), tolerance) << "trial " << trial;
+      // The pointwise formula from the one-pass derivatives agrees as closely.
+      ASSERT_LE(std::fabs(scallop::gaussianCurvatureNumeratorAt(p, u, v) - c.numerator), tolerance)
+          << "pointwise, trial " << trial;
       if (std::fabs(c.numerator) > tolerance) {
         ASSERT_EQ(got > 0, c.gaussian > 0) << "sign of K, trial " << trial;
         ++signChecks;

@@ -11,6 +11,7 @@
 #include <numbers>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "scallop/bezier.hpp"
@@ -224,6 +225,68 @@ TEST(GaussMap, RandomMultiPatchSurfacesKeepEveryNormal) {
   EXPECT_EQ(surfaces, 16);
   std::cout << surfaces << " random surfaces: " << normals << " normals, worst depth "
             << worst / kDeg << " deg; " << boundary << " boundary points checked\n";
+}
+
+// The angle from m to the nearest point of the polylines `curves` (on the sphere; chords
+// for angles, equal to 1e-8 relative at these sizes), brute force.
+double angleToCurves(const std::vector<std::vector<Vec3>>& curves, const Vec3& m) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& curve : curves) {
+    for (std::size_t i = 0; i + 1 < curve.size(); ++i) {
+      const Vec3 d = curve[i + 1] - curve[i];
+      const double length2 = scallop::dot(d, d);
+      const double t = length2 > 0.0 ? std::clamp(scallop::dot(m - curve[i], d) / length2, 0.0, 1.0) : 0.0;
+      best = std::min(best, scallop::norm(m - (curve[i] + t * d)));
+    }
+  }
+  return best;
+}
+
+TEST(GaussMap, CoarseBandKeepsTheFineMap) {
+  // At a tolerance fine enough for the band (3e-4 degree), the map with curves deep inside
+  // Omega sampled coarsely against the map sampled to the tolerance everywhere: the same
+  // boundary (each within the tolerance of the true one: within 2 tolerances of each
+  // other; every third vertex checked) and the sampled normals all inside. Single patches (the paper's, a random one)
+  // and multi-patch surfaces with seams (C0-joined) and without.
+  const double tol = 3e-4 * kDeg;
+  std::vector<std::pair<std::string, Surface>> cases{
+      {"paper-1", scallop::exampleSurface("paper-1")},
+      {"paper-2", scallop::exampleSurface("paper-2")},
+      {"two-patch", twoPatchSurface()}};
+  std::mt19937_64 rng(77);
+  for (int attempt = 0; cases.size() < 7 && attempt < 100; ++attempt) {
+    const int layout = static_cast<int>(cases.size()) - 3;  // 0 .. 3
+    Surface s;
+    const int patches = layout == 0 ? 1 : 2 + layout % 2;
+    if (!randomSurface(rng, patches, layout >= 2, layout % 2 == 1, s)) continue;
+    cases.emplace_back("random " + std::to_string(patches) + " patches, layout " + std::to_string(layout), s);
+  }
+  ASSERT_EQ(cases.size(), 7u);
+  for (const auto& [name, s] : cases) {
+    SCOPED_TRACE(name);
+    scallop::GaussMapOptions options;
+    options.toleranceRad = tol;
+    const scallop::GaussMap banded = scallop::symmetrizedGaussMap(s, options);
+    options.coarseBand = false;
+    const scallop::GaussMap full = scallop::symmetrizedGaussMap(s, options);
+    ASSERT_EQ(banded.kind, scallop::GaussMapKind::region);
+    ASSERT_EQ(full.kind, scallop::GaussMapKind::region);
+    EXPECT_TRUE(banded.coarseBandUsed);
+    EXPECT_FALSE(full.coarseBandUsed);
+    EXPECT_EQ(banded.loops.size(), full.loops.size());
+    double worst = 0.0;
+    for (const auto& [from, to] : {std::pair{&banded, &full}, std::pair{&full, &banded}}) {
+      for (const auto& curve : from->sphereCurves) {
+        for (std::size_t i = 0; i < curve.size(); i += 3) worst = std::max(worst, angleToCurves(to->sphereCurves, curve[i]));
+      }
+    }
+    EXPECT_LE(worst, 2.0 * tol);
+    checkAgainstSamples(s, banded, tol, 30);
+    std::cout << name << ": " << banded.boundarySegments << " / " << full.boundarySegments
+              << " boundary segments (band / full), " << banded.imageVertices << " / "
+              << full.imageVertices << " image vertices, boundaries "
+              << worst / tol << " tolerances apart\n";
+  }
 }
 
 // A random curved graph patch over [0, 3]^2 and a developable patch beside it with unit

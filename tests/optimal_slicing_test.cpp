@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -404,6 +405,240 @@ TEST(OptimalSlicing, RejectsBadTolerance) {
     scallop::OptimalSlicingOptions options;
     options.toleranceRad = bad * kDeg;
     EXPECT_THROW(scallop::optimalSlicing(s, options), scallop::Error);
+  }
+}
+
+// ---------------------------------------------------------------------------------------
+// The coarse-to-fine medial-axis search (bestCircles) against the full-resolution one.
+
+// A smooth star-shaped loop about `centre`: r(theta) = radius (1 + sum of five harmonics of
+// total amplitude <= `wobble`), n vertices at even steps of theta.
+std::vector<Vec2> starLoop(std::mt19937_64& rng, Vec2 centre, double radius, double wobble, int n) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::array<double, 5> amplitude{};
+  std::array<double, 5> phase{};
+  double total = 0.0;
+  for (std::size_t k = 0; k < amplitude.size(); ++k) {
+    amplitude[k] = unit(rng) / double(k + 1);
+    phase[k] = 2.0 * std::numbers::pi * unit(rng);
+    total += amplitude[k];
+  }
+  std::vector<Vec2> loop;
+  for (int i = 0; i < n; ++i) {
+    const double theta = 2.0 * std::numbers::pi * i / n;
+    double r = 1.0;
+    for (std::size_t k = 0; k < amplitude.size(); ++k) {
+      r += wobble / total * amplitude[k] * std::cos(double(k + 2) * theta + phase[k]);
+    }
+    loop.push_back(centre + radius * r * Vec2{std::cos(theta), std::sin(theta)});
+  }
+  return loop;
+}
+
+// Like the Gauss map's projected complement: an outer blob about the origin with a hole
+// round the origin (the south pole lies in Omega) and sometimes a second, off-centre hole;
+// `total` vertices in all.
+scallop::PlanarDomain randomBlobDomain(std::mt19937_64& rng, int total) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  auto jitter = [&](double size) { return Vec2{size * (2.0 * unit(rng) - 1.0), size * (2.0 * unit(rng) - 1.0)}; };
+  const bool secondHole = unit(rng) < 0.5;
+  scallop::PlanarDomain domain;
+  // Outer radius in [0.75, 1.25] about a centre within 0.1 * sqrt(2) of the origin; the
+  // hole's in [0.2, 0.3] about a centre within 0.05 * sqrt(2) (so it holds the origin); the
+  // second hole's in [0.064, 0.096], 0.5 from the origin: all disjoint (0.5 - 0.071 > 0.3 +
+  // 0.096, 0.5 + 0.142 + 0.096 < 0.75).
+  domain.loops.push_back(starLoop(rng, jitter(0.1), 1.0, 0.25, total * 3 / 5));
+  domain.loops.push_back(starLoop(rng, jitter(0.05), 0.25, 0.2, total / 4));
+  if (secondHole) {
+    const double angle = 2.0 * std::numbers::pi * unit(rng);
+    domain.loops.push_back(starLoop(rng, 0.5 * Vec2{std::cos(angle), std::sin(angle)}, 0.08, 0.2, total * 3 / 20));
+  }
+  return domain;
+}
+
+std::size_t segmentsOf(const scallop::PlanarDomain& domain) {
+  std::size_t n = 0;
+  for (const auto& loop : domain.loops) n += loop.size();
+  return n;
+}
+
+double diagonalOf(const scallop::PlanarDomain& domain) {
+  Vec2 low{1e300, 1e300}, high{-1e300, -1e300};
+  for (const auto& loop : domain.loops) {
+    for (const Vec2& p : loop) {
+      low = {std::min(low.x, p.x), std::min(low.y, p.y)};
+      high = {std::max(high.x, p.x), std::max(high.y, p.y)};
+    }
+  }
+  return scallop::norm(high - low);
+}
+
+// The coarse-to-fine search against the full-resolution one (the reference: the direct
+// search, the medial axis of the whole domain, itself checked against a brute-force
+// clearance: its best circle is a maximal empty disc). Returns the coarse-to-fine result.
+//  - Both medial axes accepted at the same rotation (the usual case): the domains share
+//    their integer grid, so the best circle must agree to 1e-12 in alpha (relative) and
+//    1e-9 of the domain's size, and so must every rival within the window; where circles
+//    tie with the best (within 1e-12 in alpha), the circle found must be one of the ties.
+//  - Boost's diagram of one domain failed validation and was rebuilt rotated (medial_axis.hpp):
+//    the two integer domains differ by rounding (0.71 grid steps q), so alpha agrees to a few
+//    q (the conformal factor is <= 2) and the circle found is an empty disc of the full
+//    domain to the medial axis's tolerance. `sameGrid` counts the first kind.
+scallop::BestCircles expectSameBestCircle(const scallop::PlanarDomain& domain, double windowRad,
+                                          std::size_t minSegments, int& sameGrid) {
+  scallop::BestCirclesOptions fineOptions;
+  fineOptions.windowRad = windowRad;
+  fineOptions.coarseToFine = false;
+  scallop::BestCirclesOptions coarseOptions = fineOptions;
+  coarseOptions.coarseToFine = true;
+  coarseOptions.coarseToFineMinSegments = minSegments;
+  const scallop::BestCircles full = scallop::bestCircles(domain, fineOptions);
+  const scallop::BestCircles fast = scallop::bestCircles(domain, coarseOptions);
+  const double size = diagonalOf(domain);
+  const scallop::PlaneCircle& c = full.best.circle;
+  EXPECT_TRUE(scallop::insideDomain(domain, c.center));
+  EXPECT_NEAR(scallop::clearance(domain, c.center), c.radius, 2.0 * full.axis.tolerance);
+  if (fast.axis.rotationRad != full.axis.rotationRad) {
+    const double q = std::max(full.axis.tolerance, fast.axis.tolerance);
+    EXPECT_NEAR(fast.best.alphaRad, full.best.alphaRad, 8.0 * q);
+    EXPECT_GE(scallop::clearance(domain, fast.best.circle.center), fast.best.circle.radius - 4.0 * q);
+    EXPECT_TRUE(scallop::insideDomain(domain, fast.best.circle.center));
+    return fast;
+  }
+  ++sameGrid;
+  EXPECT_NEAR(fast.best.alphaRad, full.best.alphaRad, 1e-12 * full.best.alphaRad);
+  auto sameCircle = [size](const scallop::PlaneCircle& a, const scallop::PlaneCircle& b) {
+    return scallop::norm(a.center - b.center) <= 1e-9 * size && std::abs(a.radius - b.radius) <= 1e-9 * size;
+  };
+  auto tiesWithBest = [&full](const scallop::RatedCircle& r) {
+    return r.alphaRad >= full.best.alphaRad * (1.0 - 1e-12);
+  };
+  bool tied = false;
+  for (const scallop::RatedCircle& r : full.rivals) tied = tied || (tiesWithBest(r) && !sameCircle(r.circle, c));
+  if (!tied) {
+    EXPECT_TRUE(sameCircle(fast.best.circle, c))
+        << "centre (" << fast.best.circle.center.x << ", " << fast.best.circle.center.y << ") r "
+        << fast.best.circle.radius << " vs (" << c.center.x << ", " << c.center.y << ") r " << c.radius;
+  } else {
+    bool found = false;
+    for (const scallop::RatedCircle& r : full.rivals) found = found || (tiesWithBest(r) && sameCircle(r.circle, fast.best.circle));
+    EXPECT_TRUE(found) << "not one of the full search's tied circles";
+  }
+  // Each rival within the window is one of the full search's, and vice versa.
+  auto among = [&](const scallop::RatedCircle& r, const std::vector<scallop::RatedCircle>& list) {
+    for (const scallop::RatedCircle& q : list) {
+      if (std::abs(q.alphaRad - r.alphaRad) <= 1e-12 * full.best.alphaRad && sameCircle(q.circle, r.circle)) return true;
+    }
+    return false;
+  };
+  for (const scallop::RatedCircle& r : fast.rivals) EXPECT_TRUE(among(r, full.rivals)) << "extra rival, alpha " << r.alphaRad;
+  for (const scallop::RatedCircle& r : full.rivals) EXPECT_TRUE(among(r, fast.rivals)) << "missed rival, alpha " << r.alphaRad;
+  return fast;
+}
+
+TEST(BestCircles, CoarseToFineMatchesFullResolutionOnRandomBlobs) {
+  // Six domains of 3,000-6,000 vertices, with the scheme's threshold lowered to 1,000
+  // segments so that it runs (the full reference costs ~0.05 s per 1,000 segments).
+  std::mt19937_64 rng(42);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int sameGrid = 0;
+  for (int trial = 0; trial < 6; ++trial) {
+    SCOPED_TRACE("trial " + std::to_string(trial));
+    const scallop::PlanarDomain domain = randomBlobDomain(rng, 3000 + static_cast<int>(3000.0 * unit(rng)));
+    const scallop::BestCircles fast = expectSameBestCircle(domain, 1e-4, 1000, sameGrid);
+    // The scheme did run coarse and verified (no fallback to the full domain).
+    EXPECT_GT(fast.simplificationTolerance, 0.0);
+    EXPECT_LT(fast.segments, segmentsOf(domain) / 2);
+  }
+  EXPECT_GE(sameGrid, 4);  // all 6 when written
+}
+
+TEST(BestCircles, CoarseToFineMatchesFullResolutionAtPipelineSize) {
+  // One domain of 20,000-30,000 vertices, at the pipeline's threshold (3,000 segments).
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const scallop::PlanarDomain domain = randomBlobDomain(rng, 20000 + static_cast<int>(10000.0 * unit(rng)));
+  int sameGrid = 0;
+  const scallop::BestCircles fast = expectSameBestCircle(domain, 1e-4, 3000, sameGrid);
+  EXPECT_GT(fast.simplificationTolerance, 0.0);
+  EXPECT_LT(fast.segments, segmentsOf(domain) / 5);
+  EXPECT_EQ(sameGrid, 1);
+}
+
+TEST(BestCircles, CoarseToFineMatchesFullResolutionOnDegenerateDomains) {
+  // 3,000 + 2,000 vertices per domain; the scheme's threshold lowered to 1,000 segments.
+  auto circle = [](Vec2 centre, double radius, int n, double wobble) {
+    std::vector<Vec2> loop;
+    for (int i = 0; i < n; ++i) {
+      const double t = 2.0 * std::numbers::pi * i / n;
+      loop.push_back(centre + radius * (1.0 + wobble * std::cos(3.0 * t)) * Vec2{std::cos(t), std::sin(t)});
+    }
+    return loop;
+  };
+  constexpr int kOuter = 3000;
+  constexpr int kInner = 2000;
+  int sameGrid = 0;
+  {
+    // Every point of the medial axis (the circle of radius 0.65) ties: the whole domain is
+    // refined, and the result is the full search's.
+    SCOPED_TRACE("concentric annulus about the origin");
+    scallop::PlanarDomain domain;
+    domain.loops = {circle({0.0, 0.0}, 1.0, kOuter, 0.0), circle({0.0, 0.0}, 0.3, kInner, 0.0)};
+    expectSameBestCircle(domain, 0.0, 1000, sameGrid);
+  }
+  {
+    SCOPED_TRACE("nearly circular: a flat landscape with one optimum");
+    scallop::PlanarDomain domain;
+    domain.loops = {circle({0.01, 0.0}, 1.0, kOuter, 1e-7), circle({0.0, 0.0}, 0.3, kInner, 0.0)};
+    const scallop::BestCircles fast = expectSameBestCircle(domain, 0.0, 1000, sameGrid);
+    EXPECT_GT(fast.simplificationTolerance, 0.0);
+  }
+  {
+    // A hole that comes within 3e-6 of the outer loop, against a delta of ~5e-5 (where the
+    // simplified outer loop crosses the hole and the search simplifies again at delta / 2,
+    // delta / 4).
+    SCOPED_TRACE("a neck narrower than delta");
+    const double offset = 0.5 - 3e-6;
+    scallop::PlanarDomain domain;
+    domain.loops = {circle({0.0, 0.0}, 1.0, kOuter, 0.0),
+                    circle({offset * std::cos(0.7), offset * std::sin(0.7)}, 0.5, kInner, 0.0)};
+    expectSameBestCircle(domain, 0.0, 1000, sameGrid);
+  }
+  {
+    // A ring 1e-6 wide: every simplification crosses the other loop, so the search falls
+    // back to the full domain.
+    SCOPED_TRACE("a ring thinner than delta");
+    scallop::PlanarDomain domain;
+    domain.loops = {circle({0.0, 0.0}, 1.0, kOuter, 0.0), circle({0.0, 0.0}, 1.0 - 1e-6, kOuter, 0.0)};
+    const scallop::BestCircles fast = expectSameBestCircle(domain, 0.0, 1000, sameGrid);
+    EXPECT_EQ(fast.simplificationTolerance, 0.0);
+    EXPECT_EQ(fast.segments, segmentsOf(domain));
+  }
+  EXPECT_EQ(sameGrid, 4);
+}
+
+// On the paper's surfaces at ~10,000 boundary segments (5e-5 degree), optimalSlicing finds
+// the same circle with and without the coarse-to-fine search.
+TEST(OptimalSlicing, CoarseToFineGivesTheFullResolutionCircle) {
+  for (const char* name : {"paper-1", "paper-2"}) {
+    SCOPED_TRACE(name);
+    const Surface s = scallop::exampleSurface(name);
+    scallop::OptimalSlicingOptions options;
+    options.toleranceRad = 5e-5 * kDeg;
+    options.certify = false;
+    const scallop::OptimalSlicing fast = scallop::optimalSlicing(s, options);
+    options.coarseToFine = false;
+    const scallop::OptimalSlicing full = scallop::optimalSlicing(s, options);
+    EXPECT_GT(full.gaussMap.boundarySegments, 8000u);
+    // The full search takes the whole map (less the few zigzag vertices removed before it).
+    EXPECT_GT(full.medialAxisSegments, full.gaussMap.boundarySegments * 99 / 100);
+    EXPECT_LT(fast.medialAxisSegments, full.medialAxisSegments / 2);
+    const double scale = std::max(1.0, scallop::norm(full.circle.center));
+    EXPECT_NEAR(fast.circle.center.x, full.circle.center.x, 1e-12 * scale);
+    EXPECT_NEAR(fast.circle.center.y, full.circle.center.y, 1e-12 * scale);
+    EXPECT_NEAR(fast.circle.radius, full.circle.radius, 1e-12 * full.circle.radius);
+    EXPECT_NEAR(fast.alphaRad, full.alphaRad, 1e-12 * full.alphaRad);
+    EXPECT_NEAR(scallop::dot(fast.normal, full.normal), 1.0, 1e-15);
   }
 }
 

@@ -115,6 +115,9 @@ TEST(OrientJson, EveryKeyInOrderAndEveryNumberBitForBit) {
                         "normal", "alpha_deg", "certified", "certified_alpha_deg",
                         "certificate_cells", "method", "circle", "sphere_circle", "pole",
                         "tolerance_deg", "gauss_map", "medial_axis", "seconds"}));
+    std::vector<std::string> medialKeys;
+    for (const auto& item : ordered.at("medial_axis").items()) medialKeys.push_back(item.key());
+    EXPECT_EQ(medialKeys, (std::vector<std::string>{"edges", "rebuilds", "segments", "refinements"}));
 
     const Json doc = Json::parse(text);
     expectSameVec3(doc.at("normal"), result.normal, "normal");
@@ -139,14 +142,17 @@ TEST(OrientJson, EveryKeyInOrderAndEveryNumberBitForBit) {
     const Json& gauss = doc.at("gauss_map");
     EXPECT_EQ(gauss.at("kind"), "region");
     EXPECT_EQ(gauss.at("loops").get<std::size_t>(), result.gaussMap.loops.size());
-    EXPECT_EQ(gauss.at("open_chains").get<std::size_t>(), result.gaussMap.openChains.size());
     EXPECT_EQ(gauss.at("boundary_segments").get<std::size_t>(),
               result.gaussMap.boundarySegments);
     EXPECT_EQ(gauss.at("parabolic_curves").get<std::size_t>(), result.gaussMap.parabolicCurves);
     EXPECT_EQ(gauss.at("candidate_pieces").get<std::size_t>(), result.gaussMap.candidatePieces);
-    EXPECT_EQ(gauss.at("membership_tests").get<std::size_t>(), result.gaussMap.membershipTests);
+    EXPECT_EQ(gauss.at("image_vertices").get<std::size_t>(), result.gaussMap.imageVertices);
+    EXPECT_EQ(gauss.at("coarse_band").get<bool>(), result.gaussMap.coarseBandUsed);
     EXPECT_EQ(doc.at("medial_axis").at("edges").get<std::size_t>(), result.medialAxisEdges);
     EXPECT_EQ(doc.at("medial_axis").at("rebuilds").get<int>(), result.medialAxisRebuilds);
+    EXPECT_EQ(doc.at("medial_axis").at("segments").get<std::size_t>(), result.medialAxisSegments);
+    EXPECT_EQ(doc.at("medial_axis").at("refinements").get<int>(), result.medialAxisRefinements);
+    EXPECT_GT(result.medialAxisSegments, 0u);
     expectSameDouble(doc.at("seconds"), result.seconds, "seconds");
   }
 }

@@ -80,6 +80,17 @@ Vec3 normalVector(const BezierPatch& patch, double u, double v);
 /// The unit normal of eq. (2); throws scallop::Error naming (u, v) where r_u x r_v vanishes.
 Vec3 unitNormal(const BezierPatch& patch, double u, double v);
 
+/// r_u, r_v, r_uu, r_uv and r_vv at one point, from the Bernstein basis and its derivatives
+/// in one pass over the control net (the separate functions above each difference the net).
+struct PatchDerivatives {
+  Vec3 u, v, uu, uv, vv;
+};
+PatchDerivatives derivativesToSecondOrder(const BezierPatch& patch, double u, double v);
+/// (r_uu . N)(r_vv . N) - (r_uv . N)^2 with N = r_u x r_v at (u, v): the value of
+/// gaussianCurvatureNumerator there, from derivativesToSecondOrder (cheaper than the
+/// polynomial of bidegree (6m - 4, 6n - 4)).
+double gaussianCurvatureNumeratorAt(const BezierPatch& patch, double u, double v);
+
 /// Split at u = t: {patch on [0, t] x [0, 1], patch on [t, 1] x [0, 1]}, each reparametrised
 /// to [0, 1]^2.
 std::pair<BezierPatch, BezierPatch> subdivideU(const BezierPatch& patch, double t);

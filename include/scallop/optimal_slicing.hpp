@@ -14,23 +14,38 @@
 //         within alpha* - margin of +-N* (margin = 1e-7 rad, which keeps the subdivision
 //         shallow; alpha* itself is exact to rounding, see Accuracy).
 // Method: symmetrized Gauss map Omega (gauss_map.hpp) -> stereographic projection with a
-//         surface normal as the pole (eqs 5-7) -> medial axis of the projected complement of
-//         Omega (medial_axis.hpp; the map's loops first cleaned of zero-width zigzags, see
-//         below) -> along every medial-axis edge, tan(alpha) = 2R / (rho^2 - R^2 + 1) (eq 12)
-//         at the edge's ends and at the roots in (0, 1) of eq (13), built in Bernstein form
-//         with R^2 for R (degree 4 for linear edges, 8 for parabolic ones) -> the best circle
-//         gives N* by eq (14), rotated back from the pole frame -> the polish: from that
-//         circle and up to three rivals within 4 tolerances of it (more than a degree apart),
-//         and from the four best of a lattice of 2,000 directions (a safety net against a
-//         Gauss map that misses normals, which the medial axis cannot see; the medial axis's
-//         seeds win ties), the minimax problem min_N max |n . N| is solved on the true
-//         surface by a trust-region SQP method: the contacts (local maxima of |n . N| over
-//         each patch, interior, on an edge or at a corner) by Newton's method from warm
-//         starts and a fixed 33 x 33 grid per patch; the step from a QP in 3 unknowns (the
-//         tangent step and the level t) over the linearised contacts with the Lagrangian's
-//         curvature, solved exactly by enumerating active sets; quadratic convergence where
-//         the optimum is a vertex of three contacts or an edge of two (the derivation is in
-//         the source). The best polished direction is N*.
+//         surface normal as the pole (eqs 5-7) -> medial axis of the projected complement
+//         of Omega (medial_axis.hpp; the map's loops first cleaned of zero-width zigzags,
+//         see below; coarse to fine above 3,000 segments, see below) -> along every edge,
+//         tan(alpha) = 2R / (rho^2 - R^2 + 1) (eq 12) at the edge's ends and at the roots
+//         in (0, 1) of eq (13), built in Bernstein form with R^2 for R (degree 4 for linear
+//         edges, 8 for parabolic ones) -> the best circle gives N* by eq (14), rotated back
+//         from the pole frame -> the polish: from that circle and up to three rivals within
+//         4 tolerances of it (more than a degree apart), and from the four best of a
+//         lattice of 2,000 directions (a safety net against a Gauss map that misses
+//         normals, which the medial axis cannot see; the medial axis's seeds win ties), the
+//         minimax problem min_N max |n . N| is solved on the true surface by a trust-region
+//         SQP method: the contacts (local maxima of |n . N| over each patch, interior, on
+//         an edge or at a corner) by Newton's method from warm starts and a fixed 33 x 33
+//         grid per patch; the step from a QP in 3 unknowns (the tangent step and the level
+//         t) over the linearised contacts with the Lagrangian's curvature, solved exactly
+//         by enumerating active sets; quadratic convergence where the optimum is a vertex
+//         of three contacts or an edge of two (the derivation is in the source). The best
+//         polished direction is N*.
+// Coarse to fine (bestCircles): the loops F are simplified by Douglas-Peucker at a planar
+//         delta (keeping ~10 sqrt(n) of their own vertices), and the search runs on a mixed
+//         domain M, whose simplified segments near the near-optimal circles are replaced by
+//         their fine chains, until M's answer is proven to be F's. M and F differ only within
+//         delta of M's unrefined segments, and moving a circle's boundary by delta changes its
+//         alpha by at most 2 delta (the projection's conformal factor 2 / (1 + |p|^2) <= 2);
+//         so when every point of M's medial axis whose alpha is within 3 delta (plus the
+//         rivals' window) of M's best lies farther than R + 2 delta from every unrefined
+//         segment (dist - R is 2-Lipschitz along the edges), F's best circle and rivals touch
+//         only refined, shared boundary and are M's. Otherwise the failing segments are
+//         refined and M rebuilt (<= 10 rounds; delta halved where simplified loops cross; the
+//         full domain as the last resort). The circles are F's to rounding, bit for bit in
+//         practice (M's vertices are F's, on the same integer grid), to the medial axis's
+//         tolerance when Boost's diagram of one of them needs a rotated rebuild.
 // Accuracy: the circle is exact for the polygonal Omega, which lies within the tolerance of
 //         the true boundary; N* and alpha* are then those of a local optimum of the true
 //         problem, to rounding (|n . N*| to ~1e-16; N* to ~1e-8 where the optimum is an edge
@@ -43,11 +58,14 @@
 //         cell-union Gauss map); the medial axis rejects those, so vertices where a loop
 //         turns back within a triangle thinner than 1% of the tolerance are removed, and
 //         loops of negligible area dropped, before it (the boundary moves by less than that).
-// Cost:   the paper's bicubic surfaces at 0.5 degree: ~24 ms (paper-1) and ~29 ms
-//         (paper-2) of CPU, of which the Gauss map 8 / 11 ms and the medial axis 7 / 6. At
-//         ~100,000 boundary segments (5e-7 degree on both): ~10 s / ~14 s, the Gauss map
-//         ~4 s / ~9 s and the medial axis ~5 s (Boost's Voronoi falls back to its
-//         multiprecision predicates on the finely sampled, nearly collinear boundary).
+// Cost:   the paper's bicubic surfaces at 0.5 degree: ~17 ms (paper-1) and ~17 ms
+//         (paper-2) of CPU, of which the Gauss map 4.5 / 7 ms and the medial axis 5 / 5. At
+//         ~100,000 boundary segments (5e-7 degree on both): 1.7-2.4 s / 1.5-2.0 s (a loaded
+//         machine), of which the Gauss map 1.1-1.6 s / 1.0-1.3 s and the medial-axis search
+//         ~0.5-0.7 s / ~0.45 s coarse to
+//         fine (one refinement round; ~3,500 coarse segments, ~8,300 / ~7,600 searched),
+//         where the full-resolution medial axis takes ~4.5-5 s (Boost's Voronoi falls back
+//         to its multiprecision predicates on the finely sampled, nearly collinear boundary).
 // Degenerate surfaces: a plane (Omega two points) gives alpha* = 90 degrees with N* any
 //         direction orthogonal to the normal (one is returned); for a surface whose Gauss
 //         image is a curve (K = 0) the result is found by maximising the minimum angle over
@@ -59,6 +77,7 @@
 #include <vector>
 
 #include "scallop/gauss_map.hpp"
+#include "scallop/medial_axis.hpp"
 #include "scallop/stereographic.hpp"
 #include "scallop/surface.hpp"
 #include "scallop/vector.hpp"
@@ -72,6 +91,10 @@ struct OptimalSlicingOptions {
   /// axis to another basin. ~5e-7 degree gives ~100,000 segments on either surface.
   double toleranceRad = 0.5 * std::numbers::pi / 180.0;
   bool certify = true;  ///< run the Bernstein-form certificate
+  /// true: the medial-axis search runs coarse-to-fine on large domains (bestCircles; the
+  /// same circle, much faster); false: always on the full-resolution domain (for
+  /// comparison and tests).
+  bool coarseToFine = true;
 };
 
 struct OptimalSlicing {
@@ -86,12 +109,56 @@ struct OptimalSlicing {
   std::string method = "medial-axis";  ///< "medial-axis", "plane" or "curve"
   GaussMap gaussMap;
   /// The interior medial axis of the projected complement (pole frame), each edge sampled
-  /// as a polyline, for figures.
+  /// as a polyline, for figures. Coarse to fine, that of the final mixed domain: the full
+  /// domain's near the best circles, a simplified one's elsewhere.
   std::vector<std::vector<Vec2>> medialAxisCurves;
   std::size_t medialAxisEdges = 0;
   int medialAxisRebuilds = 0;
+  /// Boundary segments of the final domain handed to the medial axis (the coarse-to-fine
+  /// search's mixed domain, or the whole projected complement).
+  std::size_t medialAxisSegments = 0;
+  int medialAxisRefinements = 0;  ///< refinement rounds of the coarse-to-fine search
   double seconds = 0.0;    ///< wall time of the whole computation
 };
+
+/// A circle of the stereographic plane and the angular radius of its cap on the sphere
+/// (eq 12), the quantity the medial-axis search maximises.
+struct RatedCircle {
+  double alphaRad = 0.0;
+  PlaneCircle circle;
+};
+
+struct BestCirclesOptions {
+  /// Also return every candidate circle within this angle (radians, >= 0) of the best: the
+  /// rival basins that optimalSlicing polishes (it uses 4 tolerances).
+  double windowRad = 0.0;
+  /// true: domains with more than coarseToFineMinSegments segments are searched coarse to
+  /// fine (see bestCircles); false: always the full-resolution medial axis.
+  bool coarseToFine = true;
+  std::size_t coarseToFineMinSegments = 3000;
+};
+
+/// What bestCircles found.
+struct BestCircles {
+  RatedCircle best;  ///< the greatest alpha (the first such in the axis's edge order)
+  /// Every candidate (edge end or root of eq 13) within windowRad of the best, best first
+  /// (ties in the axis's edge order); the best circle is among them.
+  std::vector<RatedCircle> rivals;
+  MedialAxis axis;               ///< the medial axis of the final domain searched
+  std::size_t segments = 0;      ///< boundary segments of that domain
+  int refinements = 0;           ///< refinement rounds of the coarse-to-fine search
+  /// Douglas-Peucker tolerance of the verified coarse domain (the domain's units); 0: the
+  /// full-resolution domain was searched (small domain, coarseToFine off, or a fallback).
+  double simplificationTolerance = 0.0;
+};
+
+/// The maximal circle of greatest alpha (eq 12) in a planar domain of the stereographic
+/// plane (the projected complement of the Gauss map, which never holds the origin): the
+/// medial axis's edges are rated at their ends and at the roots of eq (13). Coarse to fine
+/// above options.coarseToFineMinSegments (see the contract): the same best circle and rivals
+/// as the full-resolution search, to rounding. Deterministic. Throws scallop::Error when
+/// the medial axis of the full domain does, or when no circle is usable.
+BestCircles bestCircles(const PlanarDomain& domain, const BestCirclesOptions& options = {});
 
 /// The optimal slicing orientation of `surface`; throws scallop::Error on bad options.
 OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOptions& options = {});

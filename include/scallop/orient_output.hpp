@@ -18,11 +18,12 @@
 //                                            the optimal circle on the sphere (original frame),
 //    "pole": [x, y, z]                       the surface normal used as the pole,
 //    "tolerance_deg": t                      the Gauss-map tolerance the caller used,
-//    "gauss_map": {"kind": "region" | "curve" | "point", "loops", "open_chains",
+//    "gauss_map": {"kind": "region" | "curve" | "point", "loops",
 //                  "boundary_segments", "parabolic_curves" (connected parabolic lines),
-//                  "traced_cells", "fold_cells", "untraced_cells", "reversed_lobes",
-//                  "candidate_pieces", "membership_tests"}   counts (see GaussMap),
-//    "medial_axis": {"edges", "rebuilds"},
+//                  "traced_cells", "fold_cells", "untraced_cells", "candidate_pieces",
+//                  "image_vertices", "coarse_band" (bool)}   counts (see GaussMap),
+//    "medial_axis": {"edges", "rebuilds", "segments" (of the final domain searched),
+//                    "refinements" (coarse-to-fine rounds)},
 //    "seconds": s}                           wall time of optimalSlicing
 //
 // Figures (fixed-point numbers only: no exponent, nan or inf; deterministic):
