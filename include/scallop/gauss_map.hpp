@@ -52,7 +52,7 @@
 //         sampled to delta throughout: two patches' polygons of one curve would leave a
 //         sliver between them, a gap in Omega as wide as their tolerance. Measured against
 //         the map sampled to delta everywhere (3e-4 degree, 7 surfaces): the same boundary
-//         to within 0.07 delta, from 27% to 70% of the cell images' vertices. At 100,000
+//         to within 0.07 delta, from 30% to 68% of the cell images' vertices. At 100,000
 //         segments it leaves about one vertex in six to the union.
 // Thin images: beside a parabolic line a sheet can be thinner than delta (a crescent
 //         between the fold's image and a patch edge's, tangent where they meet; a spike where
