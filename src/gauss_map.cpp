@@ -291,11 +291,7 @@ class BoundaryBand {
     const auto it = cells_.find(key(cellOf(p)));
     if (it == cells_.end()) return false;
     for (std::uint32_t i : it->second) {
-      const Vec3 d = b_[i] - a_[i];
-      const double length2 = dot(d, d);
-      double t = length2 > 0.0 ? dot(p - a_[i], d) / length2 : 0.0;
-      t = std::clamp(t, 0.0, 1.0);
-      if (norm(p - (a_[i] + t * d)) <= distance) return true;
+      if (distanceToSegment(p, a_[i], b_[i]) <= distance) return true;
     }
     return false;
   }
@@ -358,8 +354,12 @@ struct NormalSampler {
               std::vector<double>* parameters) const {
     const double sm = 0.5 * (s0 + s1);
     const Vec3 nm = normalAt(sm);
-    const double limit = band != nullptr && !band->near(n0, nm, n1) ? coarseTol : tol;
-    const bool flat = angleBetween(n0, n1) <= maxStep() && deviation(n0, nm, n1) <= limit;
+    // The band is asked only when its answer decides: a deviation between tol and coarseTol.
+    bool flat = angleBetween(n0, n1) <= maxStep();
+    if (flat) {
+      const double off = deviation(n0, nm, n1);
+      flat = off <= tol || (band != nullptr && off <= coarseTol && !band->near(n0, nm, n1));
+    }
     if (flat || depth >= 40) {
       out.push_back(n1);
       if (parameters != nullptr) parameters->push_back(s1);
@@ -590,6 +590,9 @@ struct CellBuilder {
     return gaussianCurvatureNumeratorAt(*data.patch, u, v);
   }
 
+  // The sign of a value of K, as a sample records it (0 on a parabolic line).
+  static signed char signOf(double k) { return k > 0.0 ? 1 : (k < 0.0 ? -1 : 0); }
+
   // The root of K on the segment from p0 to p1, where K has opposite signs f0 and f1 at the
   // ends, as the parameter s in (0, 1): the Illinois variant of regula falsi (superlinear,
   // and bracketed; the segments are short where this runs).
@@ -647,7 +650,6 @@ struct CellBuilder {
       const UV p = pointAt(parameters[i]);
       values[i] = curvatureAt(p.u, p.v);
     }
-    auto signOf = [](double k) -> signed char { return k > 0.0 ? 1 : (k < 0.0 ? -1 : 0); };
     for (std::size_t i = 0; i < parameters.size(); ++i) {
       if (i > 0 && values[i - 1] * values[i] < 0.0) {
         const UV p0 = pointAt(parameters[i - 1]), p1 = pointAt(parameters[i]);
@@ -671,7 +673,6 @@ struct CellBuilder {
     EdgeSamples out;
     const double ka = knownSign != 0 ? knownSign : curvatureAt(a.u, a.v);
     const double kb = knownSign != 0 ? knownSign : curvatureAt(b.u, b.v);
-    auto signOf = [](double k) -> signed char { return k > 0.0 ? 1 : (k < 0.0 ? -1 : 0); };
     out.normals.push_back(normalAt(a.u, a.v));
     out.signs.push_back(signOf(ka));
     out.where.push_back(a);
@@ -800,7 +801,8 @@ struct CellBuilder {
   using CellBounds = std::array<double, 4>;
   static CellBounds boundsOf(const Cell& c) { return {c.u0, c.u1, c.v0, c.v1}; }
 
-  // The cells' images, their edges sampled by `sampler` (whose frame is the pole's).
+  // The cells' images, their edges sampled by `sampler` (whose frame is the pole's), or by
+  // `inner` (the same with the coarse band, see BoundaryBand) off the patch's seams.
   // `untraceable` receives the traced cells whose edges did not show their arc's two ends
   // (rounding at a crossing), to be subdivided in a new run.
   std::vector<CellImage> images(const NormalSampler& sampler, const NormalSampler& inner,
@@ -1087,7 +1089,7 @@ MergedSheet mergeSheet(const std::vector<IntPolygon>& cells) {
   // lesser end, -1 when it runs back: sorted, each key's sum is its net multiplicity.
   struct Edge {
     IntPoint from, to;
-    int count;
+    int count;  // +1 or -1, see above
   };
   auto less = [](const IntPoint& a, const IntPoint& b) {
     return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
@@ -1109,7 +1111,11 @@ MergedSheet mergeSheet(const std::vector<IntPolygon>& cells) {
   };
   std::sort(edges.begin(), edges.end(), byKey);
   // The directed edges left, one per unit of net multiplicity, sorted by their start.
-  std::vector<Edge> left;
+  struct Directed {
+    IntPoint from, to;
+    bool used = false;
+  };
+  std::vector<Directed> left;
   for (std::size_t i = 0; i < edges.size();) {
     std::size_t j = i;
     int net = 0;
@@ -1117,34 +1123,32 @@ MergedSheet mergeSheet(const std::vector<IntPolygon>& cells) {
       net += edges[j++].count;
     }
     for (int k = 0; k < std::abs(net); ++k) {
-      left.push_back(net > 0 ? Edge{edges[i].from, edges[i].to, 0} : Edge{edges[i].to, edges[i].from, 0});
+      left.push_back(net > 0 ? Directed{edges[i].from, edges[i].to} : Directed{edges[i].to, edges[i].from});
     }
     i = j;
   }
   edges.clear();
-  std::sort(left.begin(), left.end(), [&](const Edge& e, const Edge& f) { return less(e.from, f.from); });
-  // Walk them into loops: from each unused edge, on along an unused edge leaving its end
-  // (count marks an edge used), until back at the start.
-  auto firstFrom = [&](const IntPoint& p) {
-    return std::lower_bound(left.begin(), left.end(), p,
-                            [&](const Edge& e, const IntPoint& q) { return less(e.from, q); });
-  };
-  auto unusedFrom = [&](const IntPoint& p) -> Edge* {
-    for (auto it = firstFrom(p); it != left.end() && it->from == p; ++it) {
-      if (it->count == 0) return &*it;
+  std::sort(left.begin(), left.end(), [&](const Directed& e, const Directed& f) { return less(e.from, f.from); });
+  // Walk them into loops: from each unused edge, on along an unused edge leaving its end,
+  // until back at the start.
+  auto unusedFrom = [&](const IntPoint& p) -> Directed* {
+    auto it = std::lower_bound(left.begin(), left.end(), p,
+                               [&](const Directed& e, const IntPoint& q) { return less(e.from, q); });
+    for (; it != left.end() && it->from == p; ++it) {
+      if (!it->used) return &*it;
     }
     return nullptr;
   };
   MergedSheet out;
   out.counterClockwise = orientation > 0.0;
-  for (Edge& first : left) {
-    if (first.count != 0) continue;
-    first.count = 1;
+  for (Directed& first : left) {
+    if (first.used) continue;
+    first.used = true;
     std::vector<IntPoint> loop{first.to};
     while (!(loop.back() == first.from)) {
-      Edge* next = unusedFrom(loop.back());
+      Directed* next = unusedFrom(loop.back());
       if (next == nullptr) break;
-      next->count = 1;
+      next->used = true;
       loop.push_back(next->to);
     }
     if (loop.size() >= 3) out.loops.push_back(std::move(loop));
@@ -1185,9 +1189,8 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
   // lie deep inside Omega, and their polygons need only its tolerance (see BoundaryBand and
   // the contract). Pieces on seams are exempt: two patches' polygons of one curve, each
   // within its own tolerance, leave a sliver between them that would be a gap in Omega.
-  const double coarseTol = kCoarseBandFactor * tol;
   std::optional<BoundaryBand> band;
-  if (options.coarseBand && coarseTol <= kCoarseToleranceRad) {
+  if (options.coarseBand && kCoarseBandFactor * tol <= kCoarseToleranceRad) {
     GaussMapOptions coarseOptions = options;
     coarseOptions.toleranceRad = kCoarseToleranceRad;
     const GaussMap coarse = symmetrizedGaussMap(surface, coarseOptions);

@@ -842,13 +842,6 @@ constexpr int kMaxRefinementRounds = 10;
 // domain is thinner than delta) before the full-resolution domain is taken.
 constexpr int kSimplificationAttempts = 3;
 
-double distanceToSegment(Vec2 p, Vec2 a, Vec2 b) {
-  const Vec2 d = b - a;
-  const double length2 = dot(d, d);
-  const double t = length2 > 0.0 ? std::clamp(dot(p - a, d) / length2, 0.0, 1.0) : 0.0;
-  return norm(p - (a + t * d));
-}
-
 // Every candidate circle of a medial axis, in edge order: each edge's ends and the roots of
 // eq (13) on it, where alpha along the edge has its extrema, so that edgeBestAlpha also
 // bounds alpha over the whole edge.
@@ -1304,7 +1297,7 @@ BestCircles bestCircles(const PlanarDomain& domain, const BestCirclesOptions& op
       if (violations.empty()) {
         BestCircles out = searchResult(std::move(axis), candidates, options.windowRad);
         out.segments = segmentCount(mixed);
-        out.refinements = round;
+        out.refinements = refinements;
         out.simplificationTolerance = coarse.delta();
         return out;
       }

@@ -244,12 +244,6 @@ Box controlBox(const BezierPatch& patch) {
   return b;
 }
 
-double pointSegmentDistance(Vec2 p, Vec2 a, Vec2 b) {
-  const Vec2 ab = b - a;
-  const double len2 = dot(ab, ab);
-  const double t = len2 > 0.0 ? std::clamp(dot(p - a, ab) / len2, 0.0, 1.0) : 0.0;
-  return norm(p - (a + t * ab));
-}
 
 bool segmentsCross(Vec2 a, Vec2 b, Vec2 c, Vec2 d) {
   const double d1 = cross(b - a, c - a), d2 = cross(b - a, d - a);
@@ -269,8 +263,8 @@ double segmentBoxDistance(Vec2 a, Vec2 b, const Box& box) {
   for (int i = 0; i < 4; ++i) {
     const Vec2 c = corners[i], d = corners[(i + 1) % 4];
     if (segmentsCross(a, b, c, d)) return 0.0;
-    best = std::min({best, pointSegmentDistance(c, a, b), pointSegmentDistance(a, c, d),
-                     pointSegmentDistance(b, c, d)});
+    best = std::min({best, distanceToSegment(c, a, b), distanceToSegment(a, c, d),
+                     distanceToSegment(b, c, d)});
   }
   return best;
 }
@@ -305,7 +299,7 @@ class HeightBound {
       const int m = patch.degreeU, n = patch.degreeV;
       for (const Vec3& c : {patch.at(0, 0), patch.at(0, n), patch.at(m, 0), patch.at(m, n),
                             point(patch, 0.5, 0.5)})
-        if (pointSegmentDistance({c.x, c.y}, a, b) <= reach) known = std::max(known, c.z);
+        if (distanceToSegment({c.x, c.y}, a, b) <= reach) known = std::max(known, c.z);
       queue.push({std::move(patch), box, depth});
     };
     for (const BezierPatch& patch : surface_.patches) push(BezierPatch(patch), 0);

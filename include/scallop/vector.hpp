@@ -3,6 +3,7 @@
 // arithmetic the geometry needs. Units are the caller's (inches or millimetres for
 // positions; unit vectors are dimensionless).
 
+#include <algorithm>
 #include <cmath>
 
 namespace scallop {
@@ -42,5 +43,14 @@ constexpr Vec3 cross(Vec3 a, Vec3 b) {
 inline double norm(Vec3 a) { return std::sqrt(dot(a, a)); }
 /// a / |a|; the caller guarantees a != 0.
 inline Vec3 normalized(Vec3 a) { return a / norm(a); }
+
+/// The distance from p to the closed segment a-b (to the point a when b = a).
+template <class V>
+double distanceToSegment(V p, V a, V b) {
+  const V d = b - a;
+  const double length2 = dot(d, d);
+  const double t = length2 > 0.0 ? std::clamp(dot(p - a, d) / length2, 0.0, 1.0) : 0.0;
+  return norm(p - (a + t * d));
+}
 
 }  // namespace scallop
