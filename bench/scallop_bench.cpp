@@ -9,6 +9,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <random>
@@ -96,8 +97,8 @@ void BM_BruteForceEnvelope(benchmark::State& state) {
 //   BM_Orient/<surface>               at the default tolerance (0.5 degree, a few hundred
 //                                     boundary segments)
 //   BM_OrientFine/<surface>_100k      at the tolerance that gives ~100,000 Gauss-map boundary
-//                                     segments (issue item 7: 5e-7 degree on both surfaces;
-//                                     one iteration, about ten seconds); counters: segments,
+//                                     segments (issue item 7: 4e-7 degree on both surfaces;
+//                                     three iterations, about a second each); counters: segments,
 //                                     alpha_deg; BM_GaussMap and BM_OrientMedialAxis at the
 //                                     same tolerance for its breakdown, and BM_OrientCircle
 //                                     for the whole medial-axis search (coarse to fine, and
@@ -209,6 +210,8 @@ void BM_OrientCircle(benchmark::State& state, const char* name, double tolerance
   state.counters["searched"] = static_cast<double>(result.segments);
   state.counters["refinements"] = result.refinements;
   state.counters["alpha_deg"] = result.best.alphaRad / kDegree;
+  // Share of the final axis's edges rated at their ends alone (BestCircles::boundedEdges).
+  state.counters["bounded"] = static_cast<double>(result.boundedEdges) / static_cast<double>(std::max<std::size_t>(result.axis.edges.size(), 1));
 }
 
 // The medial axis (Boost.Polygon's Voronoi diagram, validated) of a wavy annulus with
@@ -245,18 +248,18 @@ BENCHMARK_CAPTURE(BM_OrientNoCertificate, paper1, "paper-1")->Unit(benchmark::kM
 BENCHMARK_CAPTURE(BM_OrientNoCertificate, paper2, "paper-2")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_OrientCertificate, paper1, "paper-1")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_OrientCertificate, paper2, "paper-2")->Unit(benchmark::kMillisecond);
-// The tolerance that gives ~100,000 boundary segments: 5e-7 degree, 103,797 segments on
-// paper-1 and 109,479 on paper-2 (the count grows as the tolerance's inverse square root).
-BENCHMARK_CAPTURE(BM_OrientFine, paper1_100k, "paper-1", 5e-7)->Iterations(1)->Unit(benchmark::kSecond);
-BENCHMARK_CAPTURE(BM_OrientFine, paper2_100k, "paper-2", 5e-7)->Iterations(1)->Unit(benchmark::kSecond);
-BENCHMARK_CAPTURE(BM_GaussMap, paper1_100k, "paper-1", 5e-7)->Iterations(1)->Unit(benchmark::kSecond);
-BENCHMARK_CAPTURE(BM_GaussMap, paper2_100k, "paper-2", 5e-7)->Iterations(1)->Unit(benchmark::kSecond);
-BENCHMARK_CAPTURE(BM_OrientMedialAxis, paper1_100k, "paper-1", 5e-7)->Iterations(1)->Unit(benchmark::kSecond);
-BENCHMARK_CAPTURE(BM_OrientMedialAxis, paper2_100k, "paper-2", 5e-7)->Iterations(1)->Unit(benchmark::kSecond);
-BENCHMARK_CAPTURE(BM_OrientCircle, paper1_100k, "paper-1", 5e-7, true)->Iterations(1)->Unit(benchmark::kSecond);
-BENCHMARK_CAPTURE(BM_OrientCircle, paper2_100k, "paper-2", 5e-7, true)->Iterations(1)->Unit(benchmark::kSecond);
-BENCHMARK_CAPTURE(BM_OrientCircle, paper1_100k_full, "paper-1", 5e-7, false)->Iterations(1)->Unit(benchmark::kSecond);
-BENCHMARK_CAPTURE(BM_OrientCircle, paper2_100k_full, "paper-2", 5e-7, false)->Iterations(1)->Unit(benchmark::kSecond);
+// The tolerance that gives ~100,000 boundary segments: 4e-7 degree, 100,566 segments on
+// paper-1 and 107,396 on paper-2 (the count grows as the tolerance's inverse square root).
+BENCHMARK_CAPTURE(BM_OrientFine, paper1_100k, "paper-1", 4e-7)->Iterations(3)->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(BM_OrientFine, paper2_100k, "paper-2", 4e-7)->Iterations(3)->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(BM_GaussMap, paper1_100k, "paper-1", 4e-7)->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(BM_GaussMap, paper2_100k, "paper-2", 4e-7)->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(BM_OrientMedialAxis, paper1_100k, "paper-1", 4e-7)->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(BM_OrientMedialAxis, paper2_100k, "paper-2", 4e-7)->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(BM_OrientCircle, paper1_100k, "paper-1", 4e-7, true)->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(BM_OrientCircle, paper2_100k, "paper-2", 4e-7, true)->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(BM_OrientCircle, paper1_100k_full, "paper-1", 4e-7, false)->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(BM_OrientCircle, paper2_100k_full, "paper-2", 4e-7, false)->Iterations(1)->Unit(benchmark::kSecond);
 BENCHMARK(BM_MedialAxis)->Arg(1000)->Arg(10000)->Arg(100000)->Unit(benchmark::kMillisecond);
 
 BENCHMARK(BM_ScallopHull)->RangeMultiplier(2)->Range(1 << 10, 1 << 23)->Unit(benchmark::kMillisecond);

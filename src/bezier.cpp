@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
+#include <vector>
 #include <fmt/format.h>
 
 #include "scallop/error.hpp"
@@ -88,35 +89,29 @@ Vec3 partial(const BezierPatch& patch, double u, double v, int du, int dv) {
 //   d/dt B_j^d = d (B_(j-1)^(d-1) - B_j^(d-1)),
 //   d2/dt2 B_j^d = d (d - 1) (B_(j-2)^(d-2) - 2 B_(j-1)^(d-2) + B_j^(d-2))
 // (terms with an index outside 0..degree are 0).
-struct BasisDerivatives {
-  std::vector<double> value, first, second;
-};
-BasisDerivatives basisDerivatives(int d, double t) {
-  std::vector<double> b{1.0};
-  std::vector<double> lower2, lower1;
-  for (int e = 1; e <= d; ++e) {
-    if (e == d - 1) lower2 = b;
-    if (e == d) lower1 = b;
-    std::vector<double> next(static_cast<std::size_t>(e) + 1, 0.0);
-    for (int j = 0; j <= e; ++j) {
-      const double keep = j < e ? (1.0 - t) * b[static_cast<std::size_t>(j)] : 0.0;
-      const double rise = j > 0 ? t * b[static_cast<std::size_t>(j - 1)] : 0.0;
-      next[static_cast<std::size_t>(j)] = keep + rise;
-    }
-    b = std::move(next);
-  }
-  if (d == 1) lower2.clear(), lower1 = {1.0};
-  if (d == 0) lower1.clear();
-  auto at = [](const std::vector<double>& c, int j) {
-    return j >= 0 && j < static_cast<int>(c.size()) ? c[static_cast<std::size_t>(j)] : 0.0;
+// Written into value[0..d], first[0..d] and second[0..d]: the triangle runs in place in
+// `value`, and the bases of degree d - 1 and d - 2 are kept in `first` and `second` on the
+// way, then differenced in place from the top index down (each entry reads only entries at
+// or below its own index, not yet overwritten).
+void basisDerivatives(int d, double t, double* value, double* first, double* second) {
+  value[0] = 1.0;
+  auto keep = [&](int e) {  // value[0..e] holds the basis of degree e
+    if (e == d - 2) std::copy(value, value + e + 1, second);
+    if (e == d - 1) std::copy(value, value + e + 1, first);
   };
-  BasisDerivatives out{b, std::vector<double>(b.size()), std::vector<double>(b.size())};
-  for (int j = 0; j <= d; ++j) {
-    const auto i = static_cast<std::size_t>(j);
-    out.first[i] = d * (at(lower1, j - 1) - at(lower1, j));
-    out.second[i] = d * (d - 1) * (at(lower2, j - 2) - 2.0 * at(lower2, j - 1) + at(lower2, j));
+  keep(0);
+  for (int e = 1; e <= d; ++e) {
+    value[e] = t * value[e - 1];
+    for (int j = e - 1; j >= 1; --j) value[j] = (1.0 - t) * value[j] + t * value[j - 1];
+    value[0] = (1.0 - t) * value[0];
+    keep(e);
   }
-  return out;
+  auto at = [](const double* c, int size, int j) { return j >= 0 && j < size ? c[j] : 0.0; };
+  for (int j = d; j >= 0; --j) first[j] = d >= 1 ? d * (at(first, d, j - 1) - at(first, d, j)) : 0.0;
+  for (int j = d; j >= 0; --j) {
+    second[j] = d >= 2 ? d * (d - 1) * (at(second, d - 1, j - 2) - 2.0 * at(second, d - 1, j - 1) + at(second, d - 1, j))
+                       : 0.0;
+  }
 }
 
 BezierPatch fromCoordinates(const std::array<Bernstein2, 3>& xyz) {
@@ -187,14 +182,17 @@ Vec3 unitNormal(const BezierPatch& patch, double u, double v) {
   // gamma_{3(m+n)+2} S_u of the exact one (differences, de Casteljau, the degree factor),
   // likewise r_v, and the cross product adds 3u |r_u||r_v|: below (6(m + n) + 8) u S_u S_v
   // the computed normal may be rounding noise, and its direction meaningless.
-  double su = 0.0;
-  double sv = 0.0;
+  auto squaredNorm = [](const Vec3& d) { return dot(d, d); };
+  double su2 = 0.0;  // the squares (one square root each below: sqrt is monotone)
+  double sv2 = 0.0;
   for (int j = 0; j <= m; ++j) {
     for (int k = 0; k <= n; ++k) {
-      if (j < m) su = std::max(su, norm(patch.at(j + 1, k) - patch.at(j, k)));
-      if (k < n) sv = std::max(sv, norm(patch.at(j, k + 1) - patch.at(j, k)));
+      if (j < m) su2 = std::max(su2, squaredNorm(patch.at(j + 1, k) - patch.at(j, k)));
+      if (k < n) sv2 = std::max(sv2, squaredNorm(patch.at(j, k + 1) - patch.at(j, k)));
     }
   }
+  const double su = std::sqrt(su2);
+  const double sv = std::sqrt(sv2);
   const double length = norm(normal);
   const double threshold = (6.0 * (m + n) + 8.0) * kUnitRoundoff * (m * su) * (n * sv);
   if (!(length > threshold)) {
@@ -268,24 +266,38 @@ Bernstein2 normalLengthSquared(const BezierPatch& patch) {
 }
 
 PatchDerivatives derivativesToSecondOrder(const BezierPatch& patch, double u, double v) {
-  const BasisDerivatives bu = basisDerivatives(patch.degreeU, u);
-  const BasisDerivatives bv = basisDerivatives(patch.degreeV, v);
+  const int m = patch.degreeU;
+  const int n = patch.degreeV;
+  // Three rows of basis values per direction (value, first, second derivative), su and sv
+  // apart; on the stack up to degree 15.
+  constexpr int kSmall = 16;
+  const bool onStack = std::max(m, n) < kSmall;
+  const int su = onStack ? kSmall : m + 1;
+  const int sv = onStack ? kSmall : n + 1;
+  std::array<double, 6 * kSmall> small;
+  std::vector<double> large;
+  double* bu = small.data();
+  if (!onStack) {
+    large.resize(3 * static_cast<std::size_t>(su + sv));
+    bu = large.data();
+  }
+  double* bv = bu + 3 * su;
+  basisDerivatives(m, u, bu, bu + su, bu + 2 * su);
+  basisDerivatives(n, v, bv, bv + sv, bv + 2 * sv);
   PatchDerivatives out{};
-  for (int j = 0; j <= patch.degreeU; ++j) {
-    const auto ju = static_cast<std::size_t>(j);
+  for (int j = 0; j <= m; ++j) {
     Vec3 row0{}, row1{}, row2{};  // the row's sums with the v basis and its derivatives
-    for (int k = 0; k <= patch.degreeV; ++k) {
-      const auto kv = static_cast<std::size_t>(k);
+    for (int k = 0; k <= n; ++k) {
       const Vec3& p = patch.at(j, k);
-      row0 = row0 + bv.value[kv] * p;
-      row1 = row1 + bv.first[kv] * p;
-      row2 = row2 + bv.second[kv] * p;
+      row0 = row0 + bv[k] * p;
+      row1 = row1 + bv[sv + k] * p;
+      row2 = row2 + bv[2 * sv + k] * p;
     }
-    out.u = out.u + bu.first[ju] * row0;
-    out.v = out.v + bu.value[ju] * row1;
-    out.uu = out.uu + bu.second[ju] * row0;
-    out.uv = out.uv + bu.first[ju] * row1;
-    out.vv = out.vv + bu.value[ju] * row2;
+    out.u = out.u + bu[su + j] * row0;
+    out.v = out.v + bu[j] * row1;
+    out.uu = out.uu + bu[2 * su + j] * row0;
+    out.uv = out.uv + bu[su + j] * row1;
+    out.vv = out.vv + bu[j] * row2;
   }
   return out;
 }

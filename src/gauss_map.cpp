@@ -15,8 +15,8 @@
 #include <set>
 #include <tuple>
 #include <unordered_map>
+#include <clipper.hpp>
 #include <fmt/format.h>
-#include <boost/polygon/polygon.hpp>
 
 #include "scallop/bernstein.hpp"
 #include "scallop/bezier.hpp"
@@ -594,25 +594,30 @@ struct CellBuilder {
   static signed char signOf(double k) { return k > 0.0 ? 1 : (k < 0.0 ? -1 : 0); }
 
   // The root of K on the segment from p0 to p1, where K has opposite signs f0 and f1 at the
-  // ends, as the parameter s in (0, 1): the Illinois variant of regula falsi (superlinear,
-  // and bracketed; the segments are short where this runs).
-  double curvatureRoot(UV p0, UV p1, double f0, double f1) const {
+  // ends, as the parameter s in (0, 1), to `width`: regula falsi with the Anderson-Bjorck
+  // modification (bracketed; about five evaluations where Illinois took ten on the traced
+  // arcs: the retained end's value is scaled by 1 - f_new / f_old, not by a half, when that
+  // is positive).
+  double curvatureRoot(UV p0, UV p1, double f0, double f1, double width = 1e-15) const {
     auto at = [&](double s) { return curvatureAt(p0.u + s * (p1.u - p0.u), p0.v + s * (p1.v - p0.v)); };
     double s0 = 0.0, s1 = 1.0;
     double root = 0.5;
     int side = 0;
-    for (int it = 0; it < 100 && s1 - s0 > 1e-15; ++it) {
+    for (int it = 0; it < 100 && s1 - s0 > width; ++it) {
       root = (s0 * f1 - s1 * f0) / (f1 - f0);
       if (!(root > s0 && root < s1)) root = 0.5 * (s0 + s1);
       const double f = at(root);
       if (f == 0.0) break;
       if ((f < 0.0) == (f0 < 0.0)) {
+        // The s1 end is retained: scaled when it was retained last time too.
+        const double scale = 1.0 - f / f0;
+        if (side == -1) f1 *= scale > 0.0 ? scale : 0.5;
         s0 = root, f0 = f;
-        if (side == -1) f1 *= 0.5;
         side = -1;
       } else {
+        const double scale = 1.0 - f / f1;
+        if (side == 1) f0 *= scale > 0.0 ? scale : 0.5;
         s1 = root, f1 = f;
-        if (side == 1) f0 *= 0.5;
         side = 1;
       }
     }
@@ -697,20 +702,40 @@ struct CellBuilder {
     const bool graphOfU = c.traceAxis == 1;
     const double from = graphOfU ? a.u : a.v, to = graphOfU ? b.u : b.v;
     if (from == to) return {normalAt(a.u, a.v), normalAt(b.u, b.v)};
+    // The root on each chord is bracketed first near the previous chord's (the line is a
+    // graph, so it moves continuously across the chords), the bracket widened eightfold
+    // until K changes sign across it, up to the whole chord: a narrow bracket saves half
+    // the curvature evaluations.
+    double previous = -1.0;  // the previous chord's root (parameter along the chord), if any
     auto pointAt = [&](double s) -> UV {
       if (s == 0.0) return a;
       if (s == 1.0) return b;
       const double t = from + s * (to - from);
       const UV lo = graphOfU ? UV{t, c.v0} : UV{c.u0, t};
       const UV hi = graphOfU ? UV{t, c.v1} : UV{c.u1, t};
-      const double f0 = curvatureAt(lo.u, lo.v), f1 = curvatureAt(hi.u, hi.v);
+      auto along = [&](double r) { return UV{lo.u + r * (hi.u - lo.u), lo.v + r * (hi.v - lo.v)}; };
+      auto curvature = [&](double r) {
+        const UV p = along(r);
+        return curvatureAt(p.u, p.v);
+      };
+      for (double halfWidth = 1.0 / 64.0; previous >= 0.0 && halfWidth < 0.5; halfWidth *= 8.0) {
+        const double r0 = std::max(0.0, previous - halfWidth), r1 = std::min(1.0, previous + halfWidth);
+        const double f0 = curvature(r0), f1 = curvature(r1);
+        if (f0 * f1 < 0.0) {
+          const double r = r0 + (r1 - r0) * curvatureRoot(along(r0), along(r1), f0, f1, 1e-15 / (r1 - r0));
+          previous = r;
+          return along(r);
+        }
+      }
+      const double f0 = curvature(0.0), f1 = curvature(1.0);
       double r = 0.0;
       if (f0 * f1 < 0.0) {
         r = curvatureRoot(lo, hi, f0, f1);
+        previous = r;
       } else {
         r = std::abs(f0) <= std::abs(f1) ? 0.0 : 1.0;  // rounding at the arc's ends
       }
-      return {lo.u + r * (hi.u - lo.u), lo.v + r * (hi.v - lo.v)};
+      return along(r);
     };
     return sampler.curve([&](double s) {
       const UV p = pointAt(s);
@@ -951,11 +976,11 @@ struct CellBuilder {
   }
 };
 
-namespace bp = boost::polygon;
-using IntPoint = bp::point_data<int>;
-using IntPolygon = bp::polygon_data<int>;
-using IntPolygonWithHoles = bp::polygon_with_holes_data<int>;
-using IntPolygonSet = bp::polygon_set_data<int>;
+// The union runs on Clipper's integer grid (libpolyclipping, Clipper 6): coordinates below
+// 2^30 in magnitude keep its products in 64 bits.
+using IntPoint = ClipperLib::IntPoint;
+using IntLoop = ClipperLib::Path;
+using IntLoops = ClipperLib::Paths;
 
 // Andrew's monotone chain: the convex hull of a point set, counter-clockwise.
 std::vector<Vec2> convexHull(std::vector<Vec2> points) {
@@ -1063,28 +1088,22 @@ double angleToArc(const Vec3& p, const Vec3& a, const Vec3& b) {
 }
 
 // Twice the signed area of an integer loop (positive counter-clockwise), in double.
-double signedArea2(const std::vector<IntPoint>& loop) {
+double signedArea2(const IntLoop& loop) {
   double sum = 0.0;
   for (std::size_t i = 0; i < loop.size(); ++i) {
     const IntPoint& a = loop[i];
     const IntPoint& b = loop[(i + 1) % loop.size()];
-    sum += static_cast<double>(a.x()) * b.y() - static_cast<double>(b.x()) * a.y();
+    sum += static_cast<double>(a.X) * static_cast<double>(b.Y) - static_cast<double>(b.X) * static_cast<double>(a.Y);
   }
   return sum;
 }
 
 // The union of one sheet's cell polygons (all of one orientation, sharing vertices exactly):
 // the directed edges left after each edge met in both directions cancels, walked into loops.
-// The loops are to be inserted with the sheet's orientation (`counterClockwise`) as their
-// winding, so that each edge counts by its own direction: where the walk joins pieces of
-// opposite sense at a vertex (a hole touching the outline), the loop's parts still add
-// and subtract as the cells did.
-struct MergedSheet {
-  std::vector<std::vector<IntPoint>> loops;
-  bool counterClockwise = true;
-};
-
-MergedSheet mergeSheet(const std::vector<IntPolygon>& cells) {
+// Their winding number (each edge counted by its own direction) is the cells' summed: where
+// the walk joins pieces of opposite sense at a vertex (a hole touching the outline), the
+// loop's parts still add and subtract as the cells did.
+IntLoops mergeSheet(const IntLoops& cells) {
   // Every edge under its undirected key (the lesser end first) with +1 when it runs from the
   // lesser end, -1 when it runs back: sorted, each key's sum is its net multiplicity.
   struct Edge {
@@ -1092,13 +1111,10 @@ MergedSheet mergeSheet(const std::vector<IntPolygon>& cells) {
     int count;  // +1 or -1, see above
   };
   auto less = [](const IntPoint& a, const IntPoint& b) {
-    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
+    return a.X < b.X || (a.X == b.X && a.Y < b.Y);
   };
   std::vector<Edge> edges;
-  double orientation = 0.0;
-  for (const IntPolygon& polygon : cells) {
-    const std::vector<IntPoint> points(polygon.begin(), polygon.end());
-    orientation += signedArea2(points);
+  for (const IntLoop& points : cells) {
     for (std::size_t i = 0; i < points.size(); ++i) {
       const IntPoint& a = points[i];
       const IntPoint& b = points[(i + 1) % points.size()];
@@ -1139,19 +1155,18 @@ MergedSheet mergeSheet(const std::vector<IntPolygon>& cells) {
     }
     return nullptr;
   };
-  MergedSheet out;
-  out.counterClockwise = orientation > 0.0;
+  IntLoops out;
   for (Directed& first : left) {
     if (first.used) continue;
     first.used = true;
-    std::vector<IntPoint> loop{first.to};
+    IntLoop loop{first.to};
     while (!(loop.back() == first.from)) {
       Directed* next = unusedFrom(loop.back());
       if (next == nullptr) break;
       next->used = true;
       loop.push_back(next->to);
     }
-    if (loop.size() >= 3) out.loops.push_back(std::move(loop));
+    if (loop.size() >= 3) out.push_back(std::move(loop));
   }
   return out;
 }
@@ -1328,48 +1343,55 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
   for (const Vec2& p : outer) extent = std::max({extent, std::abs(p.x), std::abs(p.y)});
   const double scale = static_cast<double>(1 << 29) / extent;
   auto toInt = [&](const Vec2& p) {
-    return IntPoint(static_cast<int>(std::lround(p.x * scale)), static_cast<int>(std::lround(p.y * scale)));
+    return IntPoint(std::llround(p.x * scale), std::llround(p.y * scale));
   };
   // Everything outside the pole cell's loop is in Omega, so only a cell image's part inside
   // a square around that loop matters: each polygon is clipped to the square of twice the
-  // loop's extent (coordinates up to 2^30 on the grid). Clipping, unlike moving far
+  // loop's extent (coordinates below 2^30 on the grid). Clipping, unlike moving far
   // vertices onto the square one by one, keeps the polygon's region and orientation: a cell
   // whose image comes close to the pole (far out in the plane) but does not hold it would
   // otherwise be folded over, and mergeSheet, which sums each sheet's cells as oriented
   // chains, would subtract it from its neighbours' region, leaving a hole in Omega.
-  const double window = 2.0 * extent;
+  const double window = (2.0 - 0x1p-28) * extent;
   auto toPolygon = [&](const std::vector<Vec2>& loop) {
-    std::vector<IntPoint> points;
+    IntLoop points;
     for (const Vec2& p : clipToSquare(loop, window)) {
       const IntPoint ip = toInt(p);
       if (points.empty() || !(points.back() == ip)) points.push_back(ip);
     }
     while (points.size() > 1 && points.front() == points.back()) points.pop_back();
-    IntPolygon polygon;
-    polygon.set(points.begin(), points.end());
-    return polygon;
+    return points;
+  };
+  // A simple loop (a hull, a strip, a cell's boundary) turned counter-clockwise: Omega is
+  // formed with the positive fill rule, every region winding +1 around its points.
+  auto counterClockwise = [](IntLoop loop) {
+    if (signedArea2(loop) < 0.0) std::reverse(loop.begin(), loop.end());
+    return loop;
+  };
+  auto run = [](ClipperLib::ClipType type, const IntLoops& subject, const IntLoops& clip,
+                ClipperLib::PolyFillType subjectFill, ClipperLib::PolyFillType clipFill) {
+    ClipperLib::Clipper clipper;
+    clipper.AddPaths(subject, ClipperLib::ptSubject, true);
+    clipper.AddPaths(clip, ClipperLib::ptClip, true);
+    IntLoops result;  // outlines counter-clockwise, holes clockwise
+    if (!clipper.Execute(type, result, subjectFill, clipFill)) throw Error("the Gauss map's polygon union failed");
+    return result;
   };
 
-  using namespace boost::polygon::operators;
-  const IntPolygon outerPolygon = toPolygon(outer);
-  IntPolygonSet inside;
-  inside.insert(outerPolygon);
-  IntPolygonSet omega;
+  const IntLoop outerLoop = counterClockwise(toPolygon(outer));
+  // Omega's pieces, each winding +1 around its points (overlaps add up); united at the end.
+  IntLoops omega;
+  auto add = [&](const IntLoops& pieces) { omega.insert(omega.end(), pieces.begin(), pieces.end()); };
   // An image that holds the pole is the outside of its projected loop (within the window).
   const auto insertOutside = [&](const std::vector<Vec2>& loop) {
-    IntPolygonSet ring;
-    ring.insert(outerPolygon);
-    IntPolygonSet cut;
-    cut.insert(toPolygon(loop));
-    IntPolygonSet rest;
-    rest = boost::polygon::operators::operator-(ring, cut);
-    omega.insert(rest);
+    add(run(ClipperLib::ctDifference, {outerLoop}, {counterClockwise(toPolygon(loop))},
+            ClipperLib::pftPositive, ClipperLib::pftPositive));
   };
   // Regular cells of one patch with one sign of K map with one orientation and share their
   // image vertices exactly with their neighbours (see CellBuilder): their union is the chain
   // left when every edge shared by two of them (traversed once each way) cancels. Handing
   // Boost those few loops instead of thousands of cells makes the union cheap.
-  std::map<std::tuple<const PatchData*, int, int>, std::vector<IntPolygon>> sheets;
+  std::map<std::tuple<const PatchData*, int, int>, IntLoops> sheets;
   // A loop of normals (for n, or -n) into its sheet. The Gauss map keeps the orientation of
   // (u, v) where K > 0 (n = r_u x r_v) and reverses it where K < 0; the antipodal map and
   // the stereographic projection from the north pole each reverse it: a part
@@ -1405,9 +1427,8 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
       if (holdsPole) {
         insertOutside(loop);
       } else {
-        // insert() only collects edges: the union is formed once, by the final difference
-        // (operator+= would clean the whole set at every call, quadratic in the cells).
-        omega.insert(toPolygon(loop));
+        // Collected only: the union is formed once, by the final difference.
+        omega.push_back(counterClockwise(toPolygon(loop)));
       }
     }
   }
@@ -1422,19 +1443,7 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
   // differs from the true image only within the tolerance of those curves, all of which
   // are normals: Omega's boundary stays within the tolerance, and no normal is cancelled.
   for (const auto& [unused, polygons] : sheets) {
-    const MergedSheet merged = mergeSheet(polygons);
-    IntPolygonSet sheet;
-    IntPolygonSet reversed;
-    for (const auto& loop : merged.loops) {
-      const bool ccw = merged.counterClockwise;
-      sheet.insert_vertex_sequence(loop.begin(), loop.end(), ccw ? bp::COUNTERCLOCKWISE : bp::CLOCKWISE, false);
-      reversed.insert_vertex_sequence(loop.begin(), loop.end(), ccw ? bp::CLOCKWISE : bp::COUNTERCLOCKWISE, false);
-    }
-    bp::arbitrary_boolean_op<int> nonzero;
-    IntPolygonSet filled;
-    nonzero.execute(filled, sheet.begin(), sheet.end(), reversed.begin(), reversed.end(),
-                    bp::arbitrary_boolean_op<int>::BOOLEAN_OR);
-    omega.insert(filled);
+    add(run(ClipperLib::ctUnion, mergeSheet(polygons), {}, ClipperLib::pftNonZero, ClipperLib::pftNonZero));
   }
   // A developable patch among curved ones: its normals form a curve (or a point) that may
   // lie outside the curved patches' region, and they are obstacles for the slicing
@@ -1463,36 +1472,53 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
           // the pole, above).
           insertOutside(loop);
         } else {
-          omega.insert(toPolygon(loop));
+          omega.push_back(counterClockwise(toPolygon(loop)));
         }
       }
     }
   }
-  IntPolygonSet complement;
-  complement = boost::polygon::operators::operator-(inside, omega);
+  const IntLoops complement = run(ClipperLib::ctDifference, {outerLoop}, omega,
+                                  ClipperLib::pftPositive, ClipperLib::pftPositive);
   // Parts of the complement may touch at a vertex (two sheets meeting at a point); the
   // medial axis needs disjoint loops. Shrinking by two grid steps (about 1e-8 of the
-  // domain) separates them and moves the boundary by far less than the tolerance.
-  complement.resize(-2);
-  std::vector<IntPolygonWithHoles> parts;
-  complement.get(parts);
+  // domain; mitred corners) separates them, removes slivers thinner than four steps, and
+  // moves the boundary by far less than the tolerance.
+  ClipperLib::PolyTree shrunk;
+  ClipperLib::ClipperOffset offset;
+  offset.AddPaths(complement, ClipperLib::jtMiter, ClipperLib::etClosedPolygon);
+  offset.Execute(shrunk, -2.0);
 
-  // Slivers (cracks the overlaps did not close, or rounding) are tiny beside the true
-  // complement: keep the components of at least 1e-6 of the largest area.
+  // The parts: each outline (a node that is not a hole: top-level, or an island inside a
+  // hole) with its holes. Slivers (cracks the overlaps did not close, or rounding) are tiny
+  // beside the true complement: keep the parts of at least 1e-6 of the largest area.
+  struct Part {
+    const ClipperLib::PolyNode* outline;
+    double area;  // twice the outline's area less its holes'
+  };
+  std::vector<Part> parts;
+  std::vector<const ClipperLib::PolyNode*> pending(shrunk.Childs.begin(), shrunk.Childs.end());
+  while (!pending.empty()) {
+    const ClipperLib::PolyNode* node = pending.back();
+    pending.pop_back();
+    Part part{node, std::abs(signedArea2(node->Contour))};
+    for (const ClipperLib::PolyNode* hole : node->Childs) {
+      part.area -= std::abs(signedArea2(hole->Contour));
+      pending.insert(pending.end(), hole->Childs.begin(), hole->Childs.end());
+    }
+    parts.push_back(part);
+  }
   double largest = 0.0;
-  for (const auto& part : parts) largest = std::max(largest, static_cast<double>(bp::area(part)));
-  auto toLoop = [&](auto begin, auto end) {
+  for (const Part& part : parts) largest = std::max(largest, part.area);
+  auto toLoop = [&](const IntLoop& contour) {
     std::vector<Vec2> loop;
-    for (auto it = begin; it != end; ++it) loop.push_back({it->x() / scale, it->y() / scale});
-    if (loop.size() > 1 && loop.front() == loop.back()) loop.pop_back();
+    loop.reserve(contour.size());
+    for (const IntPoint& p : contour) loop.push_back({static_cast<double>(p.X) / scale, static_cast<double>(p.Y) / scale});
     return loop;
   };
-  for (const auto& part : parts) {
-    if (static_cast<double>(bp::area(part)) < 1e-6 * largest) continue;
-    map.loops.push_back(toLoop(part.begin(), part.end()));
-    for (auto hole = part.begin_holes(); hole != part.end_holes(); ++hole) {
-      map.loops.push_back(toLoop(hole->begin(), hole->end()));
-    }
+  for (const Part& part : parts) {
+    if (part.area < 1e-6 * largest) continue;
+    map.loops.push_back(toLoop(part.outline->Contour));
+    for (const ClipperLib::PolyNode* hole : part.outline->Childs) map.loops.push_back(toLoop(hole->Contour));
   }
   for (const auto& loop : map.loops) {
     map.boundarySegments += loop.size();

@@ -68,16 +68,17 @@ Bernstein1 radiusSquared(const MedialEdge& edge, const Bernstein1& x, const Bern
 // a polynomial (degree 4 on linear edges with quadratic Q, 7 on parabolic ones with quartic
 // Q, as the paper counts after rationalising). Its extra roots (R = 0) are harmless: every
 // candidate is evaluated.
-std::vector<double> stationaryParameters(const MedialEdge& edge) {
-  Bernstein1 x;
-  Bernstein1 y;
+// The edge's centre c(t) = (x(t), y(t)) in Bernstein form.
+std::pair<Bernstein1, Bernstein1> centreCoordinates(const MedialEdge& edge) {
   if (edge.kind == MedialEdge::Kind::linear) {
-    x = Bernstein1{{edge.control[0].x, edge.control[1].x}};
-    y = Bernstein1{{edge.control[0].y, edge.control[1].y}};
-  } else {
-    x = Bernstein1{{edge.control[0].x, edge.control[1].x, edge.control[2].x}};
-    y = Bernstein1{{edge.control[0].y, edge.control[1].y, edge.control[2].y}};
+    return {Bernstein1{{edge.control[0].x, edge.control[1].x}}, Bernstein1{{edge.control[0].y, edge.control[1].y}}};
   }
+  return {Bernstein1{{edge.control[0].x, edge.control[1].x, edge.control[2].x}},
+          Bernstein1{{edge.control[0].y, edge.control[1].y, edge.control[2].y}}};
+}
+
+std::vector<double> stationaryParameters(const MedialEdge& edge) {
+  const auto [x, y] = centreCoordinates(edge);
   const Bernstein1 q = radiusSquared(edge, x, y);
   const Bernstein1 rho2 = add(multiply(x, x), multiply(y, y));
   const Bernstein1 left = multiply(add(add(rho2, q), constant(1.0)), derivative(q));
@@ -849,14 +850,63 @@ struct AxisCandidates {
   std::vector<RatedCircle> circles;
   std::vector<double> edgeBestAlpha;  // per edge; -1: no usable circle on it
   std::size_t best = 0;               // index into circles of the first greatest alpha
+  std::size_t boundedEdges = 0;       // edges rated at their ends alone (see rateCandidates)
 };
 
-AxisCandidates rateCandidates(const MedialAxis& axis) {
+// An upper bound of alpha over the edge's circles (pi when they may reach the origin).
+// By eq (12), tan alpha = 2R / (rho^2 - R^2 + 1) with rho = |c|: while rho > R it grows with
+// R and falls with rho. The centre stays in the hull of the edge's control points (a
+// segment, or the parabola's control triangle), which bounds rho from below. R is convex in
+// the centre's position (the distance to a point; to a line, affine, on a line/line
+// bisector), so its largest value on that hull is at a control point: the ends' radii, and
+// on a parabola the distance from its middle control point to the focus (eq 17). A
+// relative 1e-9 covers the rounding of either side.
+double alphaBound(const MedialEdge& edge) {
+  const Vec2 origin{0.0, 0.0};
+  double rMax = std::max(radiusAt(edge, 0.0), radiusAt(edge, 1.0));
+  double rhoMin = 0.0;
+  if (edge.kind == MedialEdge::Kind::linear) {
+    rhoMin = distanceToSegment(origin, edge.control[0], edge.control[1]);
+  } else {
+    const std::array<Vec2, 3>& p = edge.control;
+    for (const Vec2& q : p) rMax = std::max(rMax, norm(q - edge.siteA.a));
+    const double s0 = cross(p[1] - p[0], origin - p[0]);
+    const double s1 = cross(p[2] - p[1], origin - p[1]);
+    const double s2 = cross(p[0] - p[2], origin - p[2]);
+    const bool inside = (s0 >= 0.0 && s1 >= 0.0 && s2 >= 0.0) || (s0 <= 0.0 && s1 <= 0.0 && s2 <= 0.0);
+    if (!inside) {
+      rhoMin = std::min({distanceToSegment(origin, p[0], p[1]), distanceToSegment(origin, p[1], p[2]),
+                         distanceToSegment(origin, p[2], p[0])});
+    }
+  }
+  const double d = rhoMin * rhoMin - rMax * rMax + 1.0;
+  if (!(d > 0.0) || !std::isfinite(rMax)) return std::numbers::pi;
+  return std::atan2(2.0 * rMax, d) * (1.0 + 1e-9) + 1e-15;
+}
+
+// The candidates of `axis` (see AxisCandidates). The interior roots of eq (13) matter only
+// on edges that can hold a circle within `windowRad` of the best: every edge's ends are rated
+// first, and an edge whose alphaBound is below the best of them less the window keeps its
+// ends alone, with the bound as its edgeBestAlpha (still an upper bound, which is all the
+// coarse-to-fine test asks of it). The best circle and the rivals come out as if every root
+// had been rated, in the same order: a bypassed root's alpha is below every rival's.
+AxisCandidates rateCandidates(const MedialAxis& axis, double windowRad) {
+  double bestEnd = -1.0;
+  for (const MedialEdge& edge : axis.edges) {
+    for (double t : {0.0, 1.0}) {
+      const double r = radiusAt(edge, t);
+      const double rho = norm(pointAt(edge, t));
+      if (r > 0.0 && rho > r) bestEnd = std::max(bestEnd, alphaOfPlaneCircleRad(rho, r));
+    }
+  }
   AxisCandidates out;
   out.edgeBestAlpha.assign(axis.edges.size(), -1.0);
   for (std::size_t e = 0; e < axis.edges.size(); ++e) {
     const MedialEdge& edge = axis.edges[e];
-    std::vector<double> ts = stationaryParameters(edge);
+    std::vector<double> ts;
+    const double bound = bestEnd >= 0.0 ? alphaBound(edge) : std::numbers::pi;
+    const bool bypassed = bound < bestEnd - windowRad;
+    if (!bypassed) ts = stationaryParameters(edge);
     ts.push_back(0.0);
     ts.push_back(1.0);
     for (double t : ts) {
@@ -875,6 +925,10 @@ AxisCandidates rateCandidates(const MedialAxis& axis) {
       out.circles.push_back({alpha, {c, r}});
       out.edgeBestAlpha[e] = std::max(out.edgeBestAlpha[e], alpha);
     }
+    if (bypassed) {
+      out.edgeBestAlpha[e] = std::max(out.edgeBestAlpha[e], bound);
+      ++out.boundedEdges;
+    }
   }
   return out;
 }
@@ -889,6 +943,7 @@ BestCircles searchResult(MedialAxis axis, const AxisCandidates& candidates, doub
   std::stable_sort(out.rivals.begin(), out.rivals.end(),
                    [](const RatedCircle& a, const RatedCircle& b) { return a.alphaRad > b.alphaRad; });
   out.axis = std::move(axis);
+  out.boundedEdges = candidates.boundedEdges;
   return out;
 }
 
@@ -1267,7 +1322,7 @@ BestCircles bestCircles(const PlanarDomain& domain, const BestCirclesOptions& op
   const std::size_t fineSegments = segmentCount(domain);
   auto searchWhole = [&](int refinements) {
     MedialAxis axis = medialAxis(domain);
-    const AxisCandidates candidates = rateCandidates(axis);
+    const AxisCandidates candidates = rateCandidates(axis, options.windowRad);
     BestCircles out = searchResult(std::move(axis), candidates, options.windowRad);
     out.segments = fineSegments;
     out.refinements = refinements;
@@ -1287,7 +1342,7 @@ BestCircles bestCircles(const PlanarDomain& domain, const BestCirclesOptions& op
       } catch (const Error&) {
         break;  // the simplified loops cross where the domain is thinner than delta
       }
-      const AxisCandidates candidates = rateCandidates(axis);
+      const AxisCandidates candidates = rateCandidates(axis, options.windowRad);
       // The proof needs alpha* > 4 delta (see CoarseToFineDomain); below that delta is as
       // large as the circles, and the full domain is cheaper than refining everything.
       if (candidates.circles.empty() || !(candidates.circles[candidates.best].alphaRad > 5.0 * coarse.delta())) {

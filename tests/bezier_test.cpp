@@ -219,9 +219,18 @@ TEST(BezierEvaluate, PointAndDerivativesMatchExplicitSums) {
   constexpr std::array<std::pair<int, int>, 6> kOrders = {
       {{0, 0}, {1, 0}, {0, 1}, {2, 0}, {1, 1}, {0, 2}}};
   int checks = 0;
+  // Every bidegree up to (5, 5), and past the one-pass derivatives' stack buffers (degree 15
+  // on the stack, 16 and up on the heap).
+  std::vector<std::pair<int, int>> bidegrees;
   for (int m = 1; m <= 5; ++m) {
-    for (int n = 1; n <= 5; ++n) {
-      const int patches = (m == 3 && n == 3) ? 200 : 20;
+    for (int n = 1; n <= 5; ++n) bidegrees.emplace_back(m, n);
+  }
+  for (const auto& large : {std::pair{15, 15}, std::pair{16, 3}, std::pair{2, 16}, std::pair{17, 16}}) {
+    bidegrees.push_back(large);
+  }
+  for (const auto& [m, n] : bidegrees) {
+    {
+      const int patches = (m == 3 && n == 3) ? 200 : (m > 5 || n > 5 ? 4 : 20);
       for (int trial = 0; trial < patches; ++trial) {
         const BezierPatch p =
             trial % 2 == 0 ? graphPatch(rng, m, n, 1.0, true) : randomSpacePatch(rng, m, n);

@@ -7,8 +7,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "scallop/bezier.hpp"
@@ -202,6 +204,34 @@ TEST(OptimalSlicing, RandomGeneralPatches) {
   }
 }
 
+TEST(OptimalSlicing, RandomMultiPatchSurfacesAtAFineTolerance) {
+  // One to three general patches side by side (apart), at 1e-5 degree (~20,000-45,000
+  // boundary segments: the coarse band, the polygon union and the coarse-to-fine circle
+  // search all at work), against the brute force as above.
+  std::mt19937_64 rng(99);
+  std::uniform_real_distribution<double> jitter(-0.35, 0.35);
+  std::uniform_real_distribution<double> height(0.0, 1.5);
+  int tested = 0;
+  while (tested < 3) {
+    Surface s;
+    for (int q = 0; q <= tested; ++q) {
+      BezierPatch p;
+      for (int j = 0; j <= 3; ++j) {
+        for (int k = 0; k <= 3; ++k) p.control.push_back({4.0 * q + k + jitter(rng), j + jitter(rng), height(rng)});
+      }
+      s.patches.push_back(p);
+    }
+    try {
+      scallop::validateSurface(s);
+    } catch (const scallop::Error&) {
+      continue;
+    }
+    SCOPED_TRACE(std::to_string(tested + 1) + " patches");
+    expectAsGoodAsBruteForce(s, 1e-5);
+    ++tested;
+  }
+}
+
 TEST(OptimalSlicing, TwoPatchSurface) {
   // Two bicubic patches side by side, sharing their common boundary row (C0): the Gauss map
   // is the union of both patches' images.
@@ -323,7 +353,7 @@ double axisAngle(const Vec3& a, const Vec3& b, bool paper2Symmetry) {
 TEST(OptimalSlicing, ConvergesAsTheToleranceShrinks) {
   // Issue item 7: as the Gauss map's tolerance shrinks (down to 1e-4 degree: some 7,000
   // boundary segments on either surface, about half a second each; the benchmark runs
-  // 100,000, at 5e-7 degree),
+  // 100,000, at 4e-7 degree),
   // alpha* never decreases beyond rounding and converges to the brute force's value, and N*
   // converges (successive N* closer and closer).
   struct Case {
@@ -615,6 +645,52 @@ TEST(BestCircles, CoarseToFineMatchesFullResolutionOnDegenerateDomains) {
     EXPECT_EQ(fast.segments, segmentsOf(domain));
   }
   EXPECT_EQ(sameGrid, 4);
+}
+
+// The rating skips the roots of eq (13) on edges whose alpha bound falls short of the best
+// end less the window (BestCircles::boundedEdges). Against the same search with a window of
+// 10 rad (which bounds out nothing, so every root is rated): on 50 random domains and three
+// windows, the same best circle bit for bit, and the same rivals in the same order.
+TEST(BestCircles, EdgesRatedByTheirBoundLoseNoCandidate) {
+  std::mt19937_64 rng(11);
+  std::uniform_int_distribution<int> size(150, 600);
+  std::size_t bounded = 0, edges = 0, rivals = 0;
+  for (int trial = 0; trial < 50; ++trial) {
+    const scallop::PlanarDomain domain = randomBlobDomain(rng, size(rng));
+    scallop::BestCirclesOptions everything;
+    everything.windowRad = 10.0;
+    everything.coarseToFine = false;
+    const scallop::BestCircles reference = scallop::bestCircles(domain, everything);
+    ASSERT_EQ(reference.boundedEdges, 0u);
+    for (double window : {0.0, 1e-4, 1e-2}) {
+      SCOPED_TRACE("trial " + std::to_string(trial) + ", window " + std::to_string(window));
+      scallop::BestCirclesOptions options = everything;
+      options.windowRad = window;
+      const scallop::BestCircles found = scallop::bestCircles(domain, options);
+      bounded += found.boundedEdges;
+      edges += found.axis.edges.size();
+      EXPECT_EQ(found.best.alphaRad, reference.best.alphaRad);
+      EXPECT_EQ(found.best.circle.center.x, reference.best.circle.center.x);
+      EXPECT_EQ(found.best.circle.center.y, reference.best.circle.center.y);
+      EXPECT_EQ(found.best.circle.radius, reference.best.circle.radius);
+      std::vector<scallop::RatedCircle> expected;
+      for (const scallop::RatedCircle& r : reference.rivals) {
+        if (r.alphaRad >= reference.best.alphaRad - window) expected.push_back(r);
+      }
+      ASSERT_EQ(found.rivals.size(), expected.size());
+      rivals += expected.size();
+      for (std::size_t i = 0; i < expected.size(); ++i) {
+        EXPECT_EQ(found.rivals[i].alphaRad, expected[i].alphaRad);
+        EXPECT_EQ(found.rivals[i].circle.center.x, expected[i].circle.center.x);
+        EXPECT_EQ(found.rivals[i].circle.center.y, expected[i].circle.center.y);
+        EXPECT_EQ(found.rivals[i].circle.radius, expected[i].circle.radius);
+      }
+    }
+  }
+  // Not vacuous: most edges were bounded out.
+  EXPECT_GT(bounded, edges / 2);
+  std::printf("[          ] 150 searches: %zu of %zu edges rated by their bound, %zu rivals compared\n",
+              bounded, edges, rivals);
 }
 
 // On the paper's surfaces at ~10,000 boundary segments (5e-5 degree), optimalSlicing finds

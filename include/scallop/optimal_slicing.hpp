@@ -58,14 +58,14 @@
 //         cell-union Gauss map); the medial axis rejects those, so vertices where a loop
 //         turns back within a triangle thinner than 1% of the tolerance are removed, and
 //         loops of negligible area dropped, before it (the boundary moves by less than that).
-// Cost:   the paper's bicubic surfaces at 0.5 degree: ~17 ms (paper-1) and ~17 ms
-//         (paper-2) of CPU, of which the Gauss map 4.5 / 7 ms and the medial axis 5 / 5. At
-//         ~100,000 boundary segments (5e-7 degree on both): 1.7-2.4 s / 1.5-2.0 s (a loaded
-//         machine), of which the Gauss map 1.1-1.6 s / 1.0-1.3 s and the medial-axis search
-//         ~0.5-0.7 s / ~0.45 s coarse to
-//         fine (one refinement round; ~3,500 coarse segments, ~8,300 / ~7,600 searched),
-//         where the full-resolution medial axis takes ~4.5-5 s (Boost's Voronoi falls back
-//         to its multiprecision predicates on the finely sampled, nearly collinear boundary).
+// Cost:   the paper's bicubic surfaces at 0.5 degree: ~13-14 ms of CPU on either, of which
+//         the Gauss map 2.7 / 3.7 ms and the medial axis 5 / 4 ms. At ~100,000 boundary
+//         segments (4e-7 degree on both): 0.8-1.0 s on either (a loaded machine), of which
+//         the Gauss map 0.3-0.4 s and the medial-axis search ~0.55 s coarse to fine (one
+//         refinement round; ~3,500 coarse segments, ~8,000 / ~7,200 searched; 92% of the
+//         axis's edges rated by their bound alone), where the full-resolution medial axis
+//         takes 4-5 s (Boost's Voronoi falls back to its multiprecision predicates on the
+//         finely sampled, nearly collinear boundary).
 // Degenerate surfaces: a plane (Omega two points) gives alpha* = 90 degrees with N* any
 //         direction orthogonal to the normal (one is returned); for a surface whose Gauss
 //         image is a curve (K = 0) the result is found by maximising the minimum angle over
@@ -88,7 +88,7 @@ struct OptimalSlicingOptions {
   /// Gauss-map polygon tolerance, in (0, 0.1) rad. 0.5 degree gives 120-160 boundary
   /// segments on the paper's surfaces (the paper used a few hundred); N* is polished on the
   /// true surface afterwards, so a finer tolerance changes it only when it moves the medial
-  /// axis to another basin. ~5e-7 degree gives ~100,000 segments on either surface.
+  /// axis to another basin. ~4e-7 degree gives ~100,000 segments on either surface.
   double toleranceRad = 0.5 * std::numbers::pi / 180.0;
   bool certify = true;  ///< run the Bernstein-form certificate
   /// true: the medial-axis search runs coarse-to-fine on large domains (bestCircles; the
@@ -150,11 +150,16 @@ struct BestCircles {
   /// Douglas-Peucker tolerance of the verified coarse domain (the domain's units); 0: the
   /// full-resolution domain was searched (small domain, coarseToFine off, or a fallback).
   double simplificationTolerance = 0.0;
+  /// Edges of `axis` rated at their ends alone: an upper bound of alpha over the edge (from
+  /// its control points, see optimal_slicing.cpp) fell short of the best end less the
+  /// window, so no root of eq (13) on it could be the best or a rival.
+  std::size_t boundedEdges = 0;
 };
 
 /// The maximal circle of greatest alpha (eq 12) in a planar domain of the stereographic
 /// plane (the projected complement of the Gauss map, which never holds the origin): the
-/// medial axis's edges are rated at their ends and at the roots of eq (13). Coarse to fine
+/// medial axis's edges are rated at their ends and at the roots of eq (13) (on the edges
+/// whose bound can reach within the window of the best end). Coarse to fine
 /// above options.coarseToFineMinSegments (see the contract): the same best circle and rivals
 /// as the full-resolution search, to rounding. Deterministic. Throws scallop::Error when
 /// the medial axis of the full domain does, or when no circle is usable.
