@@ -1346,8 +1346,9 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
     return IntPoint(std::llround(p.x * scale), std::llround(p.y * scale));
   };
   // Everything outside the pole cell's loop is in Omega, so only a cell image's part inside
-  // a square around that loop matters: each polygon is clipped to the square of twice the
-  // loop's extent (coordinates below 2^30 on the grid). Clipping, unlike moving far
+  // a square around that loop matters: each polygon is clipped to the square of (2 - 2^-28)
+  // times the loop's extent (coordinates at most 2^30 - 2 on the grid, where Clipper's
+  // products stay in 64 bits; the shrinking below only moves inward). Clipping, unlike moving far
   // vertices onto the square one by one, keeps the polygon's region and orientation: a cell
   // whose image comes close to the pole (far out in the plane) but does not hold it would
   // otherwise be folded over, and mergeSheet, which sums each sheet's cells as oriented
@@ -1368,13 +1369,21 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
     if (signedArea2(loop) < 0.0) std::reverse(loop.begin(), loop.end());
     return loop;
   };
+  // One Clipper operation; its own exceptions (a coordinate out of range, which the window
+  // rules out) and failures become the project's.
   auto run = [](ClipperLib::ClipType type, const IntLoops& subject, const IntLoops& clip,
                 ClipperLib::PolyFillType subjectFill, ClipperLib::PolyFillType clipFill) {
-    ClipperLib::Clipper clipper;
-    clipper.AddPaths(subject, ClipperLib::ptSubject, true);
-    clipper.AddPaths(clip, ClipperLib::ptClip, true);
     IntLoops result;  // outlines counter-clockwise, holes clockwise
-    if (!clipper.Execute(type, result, subjectFill, clipFill)) throw Error("the Gauss map's polygon union failed");
+    bool done = false;
+    try {
+      ClipperLib::Clipper clipper;
+      clipper.AddPaths(subject, ClipperLib::ptSubject, true);
+      clipper.AddPaths(clip, ClipperLib::ptClip, true);
+      done = clipper.Execute(type, result, subjectFill, clipFill);
+    } catch (const ClipperLib::clipperException& e) {
+      throw Error(fmt::format("the Gauss map's polygon union failed: {}", e.what()));
+    }
+    if (!done) throw Error("the Gauss map's polygon union failed (Clipper's Execute)");
     return result;
   };
 
@@ -1390,7 +1399,7 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
   // Regular cells of one patch with one sign of K map with one orientation and share their
   // image vertices exactly with their neighbours (see CellBuilder): their union is the chain
   // left when every edge shared by two of them (traversed once each way) cancels. Handing
-  // Boost those few loops instead of thousands of cells makes the union cheap.
+  // Clipper those few loops instead of thousands of cells makes the union cheap.
   std::map<std::tuple<const PatchData*, int, int>, IntLoops> sheets;
   // A loop of normals (for n, or -n) into its sheet. The Gauss map keeps the orientation of
   // (u, v) where K > 0 (n = r_u x r_v) and reverses it where K < 0; the antipodal map and
@@ -1484,9 +1493,13 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
   // domain; mitred corners) separates them, removes slivers thinner than four steps, and
   // moves the boundary by far less than the tolerance.
   ClipperLib::PolyTree shrunk;
-  ClipperLib::ClipperOffset offset;
-  offset.AddPaths(complement, ClipperLib::jtMiter, ClipperLib::etClosedPolygon);
-  offset.Execute(shrunk, -2.0);
+  try {
+    ClipperLib::ClipperOffset offset;
+    offset.AddPaths(complement, ClipperLib::jtMiter, ClipperLib::etClosedPolygon);
+    offset.Execute(shrunk, -2.0);
+  } catch (const ClipperLib::clipperException& e) {
+    throw Error(fmt::format("the Gauss map's polygon union failed (shrinking): {}", e.what()));
+  }
 
   // The parts: each outline (a node that is not a hole: top-level, or an island inside a
   // hole) with its holes. Slivers (cracks the overlaps did not close, or rounding) are tiny
