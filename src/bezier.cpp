@@ -266,6 +266,7 @@ Bernstein2 normalLengthSquared(const BezierPatch& patch) {
 }
 
 PatchDerivatives derivativesToSecondOrder(const BezierPatch& patch, double u, double v) {
+  requireValid(patch, "derivativesToSecondOrder");
   const int m = patch.degreeU;
   const int n = patch.degreeV;
   // Three rows of basis values per direction (value, first, second derivative), su and sv

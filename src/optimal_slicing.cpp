@@ -68,17 +68,16 @@ Bernstein1 radiusSquared(const MedialEdge& edge, const Bernstein1& x, const Bern
 // a polynomial (degree 4 on linear edges with quadratic Q, 7 on parabolic ones with quartic
 // Q, as the paper counts after rationalising). Its extra roots (R = 0) are harmless: every
 // candidate is evaluated.
-// The edge's centre c(t) = (x(t), y(t)) in Bernstein form.
-std::pair<Bernstein1, Bernstein1> centreCoordinates(const MedialEdge& edge) {
-  if (edge.kind == MedialEdge::Kind::linear) {
-    return {Bernstein1{{edge.control[0].x, edge.control[1].x}}, Bernstein1{{edge.control[0].y, edge.control[1].y}}};
-  }
-  return {Bernstein1{{edge.control[0].x, edge.control[1].x, edge.control[2].x}},
-          Bernstein1{{edge.control[0].y, edge.control[1].y, edge.control[2].y}}};
-}
-
 std::vector<double> stationaryParameters(const MedialEdge& edge) {
-  const auto [x, y] = centreCoordinates(edge);
+  Bernstein1 x;
+  Bernstein1 y;
+  if (edge.kind == MedialEdge::Kind::linear) {
+    x = Bernstein1{{edge.control[0].x, edge.control[1].x}};
+    y = Bernstein1{{edge.control[0].y, edge.control[1].y}};
+  } else {
+    x = Bernstein1{{edge.control[0].x, edge.control[1].x, edge.control[2].x}};
+    y = Bernstein1{{edge.control[0].y, edge.control[1].y, edge.control[2].y}};
+  }
   const Bernstein1 q = radiusSquared(edge, x, y);
   const Bernstein1 rho2 = add(multiply(x, x), multiply(y, y));
   const Bernstein1 left = multiply(add(add(rho2, q), constant(1.0)), derivative(q));
@@ -859,8 +858,8 @@ struct AxisCandidates {
 // segment, or the parabola's control triangle), which bounds rho from below. R is convex in
 // the centre's position (the distance to a point; to a line, affine, on a line/line
 // bisector), so its largest value on that hull is at a control point: the ends' radii, and
-// on a parabola the distance from its middle control point to the focus (eq 17). A
-// relative 1e-9 covers the rounding of either side.
+// on a parabola the control points' distances to the focus (eq 17). A relative 1e-9 covers
+// the rounding of either side.
 double alphaBound(const MedialEdge& edge) {
   const Vec2 origin{0.0, 0.0};
   double rMax = std::max(radiusAt(edge, 0.0), radiusAt(edge, 1.0));
@@ -953,34 +952,6 @@ std::size_t segmentCount(const PlanarDomain& domain) {
   return n;
 }
 
-std::vector<std::uint32_t> douglasPeucker(const std::vector<Vec2>& loop, double delta);
-
-// The Douglas-Peucker tolerance delta that leaves about kCoarseSegmentsPerRootFine x
-// sqrt(fine) coarse segments: one trial at 1e-6 of the bounding box's diagonal, then the
-// count's law on smooth curves (a chord of sagitta delta spans a length proportional to
-// sqrt(delta), so the count goes as delta^-1/2), within a factor 100 of the trial.
-double simplificationTolerance(const PlanarDomain& domain) {
-  Vec2 low{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
-  Vec2 high = -low;
-  std::size_t fine = 0;
-  for (const auto& loop : domain.loops) {
-    fine += loop.size();
-    for (const Vec2& p : loop) {
-      low = {std::min(low.x, p.x), std::min(low.y, p.y)};
-      high = {std::max(high.x, p.x), std::max(high.y, p.y)};
-    }
-  }
-  const double trial = 1e-6 * norm(high - low);
-  if (!std::isfinite(trial) || !(trial > 0.0)) return 0.0;
-  std::size_t coarse = 0;
-  for (const auto& loop : domain.loops) {
-    if (loop.size() >= 3) coarse += douglasPeucker(loop, trial).size();
-  }
-  const double target = kCoarseSegmentsPerRootFine * std::sqrt(static_cast<double>(fine));
-  const double ratio = static_cast<double>(std::max<std::size_t>(coarse, 1)) / target;
-  return trial * std::clamp(ratio * ratio, 1e-2, 1e2);
-}
-
 // Douglas-Peucker on a closed loop: the indices (increasing, starting with 0) of the
 // vertices kept so that every vertex between two consecutive kept ones lies within `delta`
 // of the segment joining them. Vertex 0 and the loop's extreme vertices in x and y are
@@ -1035,6 +1006,32 @@ std::vector<std::uint32_t> douglasPeucker(const std::vector<Vec2>& loop, double 
     if (keep[i]) kept.push_back(static_cast<std::uint32_t>(i));
   }
   return kept;
+}
+
+// The Douglas-Peucker tolerance delta that leaves about kCoarseSegmentsPerRootFine x
+// sqrt(fine) coarse segments: one trial at 1e-6 of the bounding box's diagonal, then the
+// count's law on smooth curves (a chord of sagitta delta spans a length proportional to
+// sqrt(delta), so the count goes as delta^-1/2), within a factor 100 of the trial.
+double simplificationTolerance(const PlanarDomain& domain) {
+  Vec2 low{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+  Vec2 high = -low;
+  std::size_t fine = 0;
+  for (const auto& loop : domain.loops) {
+    fine += loop.size();
+    for (const Vec2& p : loop) {
+      low = {std::min(low.x, p.x), std::min(low.y, p.y)};
+      high = {std::max(high.x, p.x), std::max(high.y, p.y)};
+    }
+  }
+  const double trial = 1e-6 * norm(high - low);
+  if (!std::isfinite(trial) || !(trial > 0.0)) return 0.0;
+  std::size_t coarse = 0;
+  for (const auto& loop : domain.loops) {
+    if (loop.size() >= 3) coarse += douglasPeucker(loop, trial).size();
+  }
+  const double target = kCoarseSegmentsPerRootFine * std::sqrt(static_cast<double>(fine));
+  const double ratio = static_cast<double>(std::max<std::size_t>(coarse, 1)) / target;
+  return trial * std::clamp(ratio * ratio, 1e-2, 1e2);
 }
 
 // A uniform grid over segments for the verification's query: the segments that may lie

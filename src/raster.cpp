@@ -244,7 +244,6 @@ Box controlBox(const BezierPatch& patch) {
   return b;
 }
 
-
 bool segmentsCross(Vec2 a, Vec2 b, Vec2 c, Vec2 d) {
   const double d1 = cross(b - a, c - a), d2 = cross(b - a, d - a);
   const double d3 = cross(d - c, a - c), d4 = cross(d - c, b - c);

@@ -821,6 +821,9 @@ TEST(BezierErrors, InvalidPatchesAndOrdersThrow) {
   EXPECT_THROW(scallop::point(BezierPatch{0, 3, std::vector<Vec3>(4)}, 0.5, 0.5), scallop::Error);
   EXPECT_THROW(scallop::normalPolynomials(BezierPatch{3, 3, std::vector<Vec3>(15)}),
                scallop::Error);
+  EXPECT_THROW(scallop::derivativesToSecondOrder(BezierPatch{3, 3, std::vector<Vec3>(15)}, 0.5, 0.5),
+               scallop::Error);
+  EXPECT_THROW(scallop::gaussianCurvatureNumeratorAt(empty, 0.5, 0.5), scallop::Error);
   const BezierPatch ok{1, 1, {{0, 0, 0}, {0, 1, 0}, {1, 0, 0}, {1, 1, 1}}};
   EXPECT_NO_THROW(scallop::secondDerivative(ok, 0.5, 0.5, 1, 1));
   EXPECT_THROW(scallop::secondDerivative(ok, 0.5, 0.5, 1, 0), scallop::Error);

@@ -233,10 +233,7 @@ double angleToCurves(const std::vector<std::vector<Vec3>>& curves, const Vec3& m
   double best = std::numeric_limits<double>::infinity();
   for (const auto& curve : curves) {
     for (std::size_t i = 0; i + 1 < curve.size(); ++i) {
-      const Vec3 d = curve[i + 1] - curve[i];
-      const double length2 = scallop::dot(d, d);
-      const double t = length2 > 0.0 ? std::clamp(scallop::dot(m - curve[i], d) / length2, 0.0, 1.0) : 0.0;
-      best = std::min(best, scallop::norm(m - (curve[i] + t * d)));
+      best = std::min(best, scallop::distanceToSegment(m, curve[i], curve[i + 1]));
     }
   }
   return best;
@@ -246,8 +243,8 @@ TEST(GaussMap, CoarseBandKeepsTheFineMap) {
   // At a tolerance fine enough for the band (3e-4 degree), the map with curves deep inside
   // Omega sampled coarsely against the map sampled to the tolerance everywhere: the same
   // boundary (each within the tolerance of the true one: within 2 tolerances of each
-  // other; every third vertex checked) and the sampled normals all inside. Single patches (the paper's, a random one)
-  // and multi-patch surfaces with seams (C0-joined) and without.
+  // other; every third vertex checked) and the sampled normals all inside. Single patches
+  // (the paper's, a random one) and multi-patch surfaces with seams (C0-joined) and without.
   const double tol = 3e-4 * kDeg;
   std::vector<std::pair<std::string, Surface>> cases{
       {"paper-1", scallop::exampleSurface("paper-1")},

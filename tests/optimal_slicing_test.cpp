@@ -180,19 +180,24 @@ TEST(OptimalSlicing, RandomGraphPatchesInchesAndMillimetres) {
   }
 }
 
-TEST(OptimalSlicing, RandomGeneralPatches) {
-  // Control nets that are not grids over the plane: every point moved in x, y and z.
-  std::mt19937_64 rng(7);
+// A bicubic control net that is not a grid over the plane: the grid over [x0, x0 + 3] x
+// [0, 3] with every point moved in x and y by up to 0.35, heights in [0, 1.5].
+BezierPatch randomGeneralPatch(std::mt19937_64& rng, double x0) {
   std::uniform_real_distribution<double> jitter(-0.35, 0.35);
   std::uniform_real_distribution<double> height(0.0, 1.5);
+  BezierPatch p;
+  for (int j = 0; j <= 3; ++j) {
+    for (int k = 0; k <= 3; ++k) p.control.push_back({x0 + k + jitter(rng), j + jitter(rng), height(rng)});
+  }
+  return p;
+}
+
+TEST(OptimalSlicing, RandomGeneralPatches) {
+  std::mt19937_64 rng(7);
   int tested = 0;
   while (tested < 3) {
-    BezierPatch p;
-    for (int j = 0; j <= 3; ++j) {
-      for (int k = 0; k <= 3; ++k) p.control.push_back({k + jitter(rng), j + jitter(rng), height(rng)});
-    }
     Surface s;
-    s.patches.push_back(p);
+    s.patches.push_back(randomGeneralPatch(rng, 0.0));
     try {
       scallop::validateSurface(s);
     } catch (const scallop::Error&) {
@@ -209,18 +214,10 @@ TEST(OptimalSlicing, RandomMultiPatchSurfacesAtAFineTolerance) {
   // boundary segments: the coarse band, the polygon union and the coarse-to-fine circle
   // search all at work), against the brute force as above.
   std::mt19937_64 rng(99);
-  std::uniform_real_distribution<double> jitter(-0.35, 0.35);
-  std::uniform_real_distribution<double> height(0.0, 1.5);
   int tested = 0;
   while (tested < 3) {
     Surface s;
-    for (int q = 0; q <= tested; ++q) {
-      BezierPatch p;
-      for (int j = 0; j <= 3; ++j) {
-        for (int k = 0; k <= 3; ++k) p.control.push_back({4.0 * q + k + jitter(rng), j + jitter(rng), height(rng)});
-      }
-      s.patches.push_back(p);
-    }
+    for (int q = 0; q <= tested; ++q) s.patches.push_back(randomGeneralPatch(rng, 4.0 * q));
     try {
       scallop::validateSurface(s);
     } catch (const scallop::Error&) {

@@ -145,6 +145,9 @@ TEST(OrientJson, EveryKeyInOrderAndEveryNumberBitForBit) {
     EXPECT_EQ(gauss.at("boundary_segments").get<std::size_t>(),
               result.gaussMap.boundarySegments);
     EXPECT_EQ(gauss.at("parabolic_curves").get<std::size_t>(), result.gaussMap.parabolicCurves);
+    EXPECT_EQ(gauss.at("traced_cells").get<std::size_t>(), result.gaussMap.tracedCells);
+    EXPECT_EQ(gauss.at("fold_cells").get<std::size_t>(), result.gaussMap.foldCells);
+    EXPECT_EQ(gauss.at("untraced_cells").get<std::size_t>(), result.gaussMap.untracedCells);
     EXPECT_EQ(gauss.at("candidate_pieces").get<std::size_t>(), result.gaussMap.candidatePieces);
     EXPECT_EQ(gauss.at("image_vertices").get<std::size_t>(), result.gaussMap.imageVertices);
     EXPECT_EQ(gauss.at("coarse_band").get<bool>(), result.gaussMap.coarseBandUsed);

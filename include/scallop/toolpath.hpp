@@ -57,17 +57,9 @@ constexpr Vec3 toArcPlane(ArcPlane plane, Vec3 a) {
   }
   return a;
 }
-constexpr Vec3 fromArcPlane(ArcPlane plane, Vec3 a) {
-  switch (plane) {
-    case ArcPlane::xy:
-      return {a.x, a.y, a.z};
-    case ArcPlane::zx:
-      return {a.y, a.z, a.x};
-    case ArcPlane::yz:
-      return {a.z, a.x, a.y};
-  }
-  return a;
-}
+// Each arc plane's coordinates are a cyclic shift of (x, y, z), whose inverse is the same
+// shift applied twice.
+constexpr Vec3 fromArcPlane(ArcPlane plane, Vec3 a) { return toArcPlane(plane, toArcPlane(plane, a)); }
 
 struct ToolPass {
   Vec3 start;                   ///< tool centre where the pass begins
