@@ -1315,13 +1315,14 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
   for (const auto& curve : developableCurves) {
     for (const Vec3& n : curve) spread = std::max(spread, angleBetween(first, n));
   }
-  if (spread <= tol) {
+  auto asPoint = [&] {
     map.kind = GaussMapKind::point;
     map.pole = first;
     map.toPoleFrame = rotationTaking(first, {0.0, 0.0, 1.0});
     map.sphereCurves = {{first}, {-first}};
     return map;
-  }
+  };
+  if (spread <= tol) return asPoint();
   if (allDevelopable) {
     map.kind = GaussMapKind::curve;
     for (const auto& curve : developableCurves) {
@@ -1342,6 +1343,13 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
   double extent = 0.0;
   for (const Vec2& p : outer) extent = std::max({extent, std::abs(p.x), std::abs(p.y)});
   const double scale = static_cast<double>(1 << 29) / extent;
+  // A map too small for the grid: the antipodal image lies about the origin, where a grid
+  // step of extent / 2^29 spans two steps' angle, while the pole cell's image reaches out
+  // to ~2 / (its angular radius). With the normals' spread under 32 steps (2^-24 extent) the
+  // antipodal image would collapse to a few grid points (a nearly flat surface: 1 mm of twist
+  // over 10 km): the map is reported as a point, like a plane's, and optimalSlicing measures
+  // alpha on the surface itself.
+  if (spread <= 0x1p-24 * extent) return asPoint();
   auto toInt = [&](const Vec2& p) {
     return IntPoint(std::llround(p.x * scale), std::llround(p.y * scale));
   };
@@ -1377,8 +1385,11 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
     bool done = false;
     try {
       ClipperLib::Clipper clipper;
-      clipper.AddPaths(subject, ClipperLib::ptSubject, true);
-      clipper.AddPaths(clip, ClipperLib::ptClip, true);
+      const bool anySubject = clipper.AddPaths(subject, ClipperLib::ptSubject, true);
+      const bool anyClip = clipper.AddPaths(clip, ClipperLib::ptClip, true);
+      // No edge at all (a sheet whose cells all cancel or collapse on the grid): the result is
+      // empty, and Execute would report a failure.
+      if (!anySubject && !anyClip) return result;
       done = clipper.Execute(type, result, subjectFill, clipFill);
     } catch (const ClipperLib::clipperException& e) {
       throw Error(fmt::format("the Gauss map's polygon union failed: {}", e.what()));
@@ -1489,9 +1500,9 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
   const IntLoops complement = run(ClipperLib::ctDifference, {outerLoop}, omega,
                                   ClipperLib::pftPositive, ClipperLib::pftPositive);
   // Parts of the complement may touch at a vertex (two sheets meeting at a point); the
-  // medial axis needs disjoint loops. Shrinking by two grid steps (about 1e-8 of the
-  // domain; mitred corners) separates them, removes slivers thinner than four steps, and
-  // moves the boundary by far less than the tolerance.
+  // medial axis needs disjoint loops. Shrinking by two grid steps (2^-28 of the pole cell
+  // loop's extent; mitred corners) separates them and removes slivers thinner than four
+  // steps; it only grows Omega (see Accuracy in the contract for what it costs).
   ClipperLib::PolyTree shrunk;
   try {
     ClipperLib::ClipperOffset offset;

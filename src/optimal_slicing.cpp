@@ -1379,7 +1379,9 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
   std::vector<Vec3> rivals;  // medial-axis directions to polish (the best first)
 
   if (map.kind == GaussMapKind::point) {
-    // A plane: every direction in the plane of the surface is at 90 degrees.
+    // A plane, or a surface whose normals all lie within the tolerance (or too close for
+    // the Gauss map's grid, see gauss_map.hpp): a direction orthogonal to the pole, polished
+    // against the true normals (below). A plane keeps 90 degrees.
     result.method = "plane";
     result.normal = orthogonal(map.pole);
     result.alphaRad = std::numbers::pi / 2.0;
@@ -1449,6 +1451,14 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
     }
     result.alphaRad = std::acos(std::min(1.0, bestValue));
     result.sphereCircle = {result.normal, result.alphaRad};
+  } else if (result.method == "plane") {
+    double value = 0.0;
+    const Vec3 polished = polishDirection(ContactFinder(surface), result.normal, tol, value);
+    if (value > 0.0) {
+      result.normal = polished;
+      result.alphaRad = std::acos(std::min(1.0, value));
+      result.sphereCircle = {result.normal, result.alphaRad};
+    }
   }
   // Certificate: prove that no normal comes within alpha* less a small margin (what the
   // sampled-and-climbed maxima could have missed) of +-N*.

@@ -417,6 +417,30 @@ TEST(OptimalSlicing, PlaneAndCylinder) {
   EXPECT_NEAR(trueAlpha(cylinder, axis.normal) / kDeg, 90.0, 1e-3);
 }
 
+TEST(OptimalSlicing, NearlyFlatSurfaceAtFineTolerances) {
+  // A bilinear patch 10 km square (in millimetres) twisted by 1 mm: its normals lie within
+  // ~1e-7 rad of +z, a Gauss map far below its integer grid's resolution about the origin
+  // (see gauss_map.hpp), at tolerances on either side of that spread. It was once an error
+  // ("no usable circle", or an empty union). Reported as a point, alpha* is measured on the
+  // surface: below 90 degrees by at most the spread, as the brute force finds, and certified.
+  Surface s;
+  s.units = scallop::Units::millimetre;
+  s.patches.push_back(BezierPatch{1, 1, {{0, 0, 0}, {0, 1e7, 0}, {1e7, 0, 0}, {1e7, 1e7, 1}}});
+  for (double toleranceDeg : {1e-3, 1e-5, 1e-6, 4e-7, 1e-7}) {
+    SCOPED_TRACE("tolerance " + std::to_string(toleranceDeg) + " deg");
+    scallop::OptimalSlicingOptions options;
+    options.toleranceRad = toleranceDeg * kDeg;
+    const scallop::OptimalSlicing result = scallop::optimalSlicing(s, options);
+    EXPECT_EQ(result.gaussMap.kind, scallop::GaussMapKind::point);
+    EXPECT_EQ(result.method, "plane");
+    EXPECT_TRUE(result.certified);
+    EXPECT_LT(result.alphaRad, std::numbers::pi / 2);
+    EXPECT_GT(result.alphaRad, std::numbers::pi / 2 - 2e-7);
+    EXPECT_NEAR(trueAlpha(s, result.normal), result.alphaRad, 1e-9);
+  }
+  expectAsGoodAsBruteForce(s, 1e-6);
+}
+
 TEST(OptimalSlicing, CertificateRejectsAnOverclaim) {
   const Surface s = scallop::exampleSurface("paper-2");
   const scallop::OptimalSlicing result = scallop::optimalSlicing(s);

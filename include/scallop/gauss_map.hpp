@@ -53,7 +53,7 @@
 //         sampled to delta throughout: two patches' polygons of one curve would leave a
 //         sliver between them, a gap in Omega as wide as their tolerance. Measured against
 //         the map sampled to delta everywhere (3e-4 degree, 7 surfaces): the same boundary
-//         to within 0.07 delta, from 30% to 68% of the cell images' vertices. At 100,000
+//         to within 0.04 delta, from 30% to 68% of the cell images' vertices. At 100,000
 //         segments it leaves about one vertex in six to the union.
 // Thin images: beside a parabolic line a sheet can be thinner than delta (a crescent
 //         between the fold's image and a patch edge's, tangent where they meet; a spike where
@@ -65,12 +65,21 @@
 //         delta of normals, and no true normal is lost to the reversed lobes (a random
 //         four-patch surface lost a 3 degree spike to them once).
 // Accuracy: the polygon is within delta of the true boundary, plus the integer grid's
-//         rounding (2^-30 of the pole cell loop's extent: about 1e-9 rad on the paper's
-//         surfaces, which matters only below ~1e-6 degree).
+//         rounding and the 2-step shrink (which only grows Omega). A grid step is 2^-29 of
+//         the pole cell loop's extent E in the plane, and up to twice that in angle about the
+//         origin (the pole's antipode), where the conformal factor 2 / (1 + |q|^2) is 2: up
+//         to ~5 steps there, 2^-26.7 E rad. Measured: E = 24 on paper-1 (~2e-7 rad) and 7.4
+//         on paper-2 (~7e-8 rad), so below ~1e-5 degree the tolerance sharpens the boundary
+//         everywhere but near the antipodal image. N* and alpha* do not depend on it: they
+//         are polished on the true surface and certified (optimal_slicing.hpp).
+//         A map whose normals spread less than 2^-24 E (32 steps) would collapse about the
+//         origin: it is reported as a point, like a plane's (a bilinear patch 10 km square
+//         twisted by 1 mm, spread 1e-7 rad, is one).
 // Membership: whether a direction m is a normal (isSymmetrizedNormal) is decided exactly in
 //         Bernstein form: whether r_u x r_v is parallel to m (two polynomial equations)
 //         with r_u x r_v . m > 0 somewhere on a patch, by subdivision and Newton's method.
-// Degenerate surfaces: a patch with K = 0 everywhere (plane, cylinder, developable) has a
+// Degenerate surfaces: every normal within delta of one (a plane, or nearly): `kind` point.
+//         A patch with K = 0 everywhere (plane, cylinder, developable) has a
 //         Gauss image of dimension < 2, the image of its boundary curves. When every patch
 //         is such, `kind` tells, and `sphereCurves` describe the image itself, with no
 //         loops. Among curved patches a developable patch's normals are obstacles like any
@@ -96,9 +105,10 @@
 
 namespace scallop {
 
-/// The finest tolerance accepted: about the resolution of the union's integer grid (2^-30 of
-/// the pole cell's extent; see Accuracy). ~4e-7 degree (7e-9 rad) gives ~100,000 segments
-/// on the paper's surfaces; each tenfold refinement triples them.
+/// The finest tolerance accepted, a fixed floor: the union's integer grid resolves 2^-30 of
+/// the pole cell loop's extent, which depends on the surface (see Accuracy). ~4e-7 degree
+/// (7e-9 rad) gives ~100,000 segments on the paper's surfaces; each tenfold refinement
+/// triples them.
 inline constexpr double kMinGaussMapToleranceRad = 1e-9;
 
 struct GaussMapOptions {

@@ -67,7 +67,11 @@
 //         takes 4-5 s (Boost's Voronoi falls back to its multiprecision predicates on the
 //         finely sampled, nearly collinear boundary).
 // Degenerate surfaces: a plane (Omega two points) gives alpha* = 90 degrees with N* any
-//         direction orthogonal to the normal (one is returned); for a surface whose Gauss
+//         direction orthogonal to the normal (one is returned, `method` "plane"); a surface
+//         whose normals the Gauss map takes for a point (within the tolerance, or too close
+//         for its grid) gets that direction polished against its true normals, alpha* just
+//         under 90 degrees (a bilinear patch 10 km square twisted by 1 mm: 89.9999971
+//         degrees), and the certificate as usual; for a surface whose Gauss
 //         image is a curve (K = 0) the result is found by maximising the minimum angle over
 //         the curve's sampled normals directly (flagged by `method`).
 
