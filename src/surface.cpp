@@ -316,6 +316,12 @@ void validatePatch(const BezierPatch& patch, std::size_t index) {
       }
     }
   }
+  const double scale = patchScale(patch);
+  if (scale > kMaxPatchScale || (scale > 0.0 && scale < kMinPatchScale)) {
+    throw Error(fmt::format("{}: the largest |coordinate| is {:g}, outside [{:g}, {:g}] where the "
+                            "curvature polynomials neither overflow nor underflow (check the units)",
+                            where, scale, kMinPatchScale, kMaxPatchScale));
+  }
   const PatchRegularity regularity = checkPatchRegularity(patch);
   switch (regularity.verdict) {
     case RegularityVerdict::regular:

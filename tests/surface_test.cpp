@@ -198,7 +198,10 @@ TEST(Surface, JsonRoundTripIsBitwise) {
   std::mt19937_64 rng(42);
   std::uniform_int_distribution<int> degree(1, 5);
   std::uniform_int_distribution<int> patchCount(1, 4);
-  const std::array<double, 9> factors = {1e-310, 1e-150, 3e-7, 0.1, 1.0, 7.0, 1e5, 1e150, 1e300};
+  // Scales across the accepted range (kMinPatchScale .. kMaxPatchScale; a patch spans up to
+  // ~6 units before scaling), and in every patch one subnormal coordinate and one of 1e-300,
+  // so that the shortest round-trip printing is exercised at the extremes.
+  const std::array<double, 9> factors = {1e-19, 1e-15, 3e-7, 0.1, 1.0, 7.0, 1e5, 1e15, 1e19};
   for (int trial = 0; trial < 200; ++trial) {
     Surface surface;
     surface.units = trial % 2 == 0 ? Units::inch : Units::millimetre;
@@ -208,6 +211,8 @@ TEST(Surface, JsonRoundTripIsBitwise) {
       BezierPatch patch = randomGraphPatch(rng, degree(rng), degree(rng), 2.0);
       for (Vec3& p : patch.control) p = factor * p;
       patch.control[0].z = -0.0;
+      patch.control[1].z = 4.9406564584124654e-324 * (1 + trial % 7);  // subnormal
+      patch.control.back().z = 1e-300;
       surface.patches.push_back(std::move(patch));
     }
     const std::string text = surfaceToJson(surface);
@@ -437,6 +442,17 @@ TEST(Surface, ValidatesSurfacesBuiltInMemory) {
   notFinite.patches[1].control[6].y = std::nan("");
   expectMessageContains(validationError(notFinite), {"patches[1].control_points[1][2]", "nan"},
                         "nan");
+
+  // Too large or too small for the curvature polynomials (overflow, underflow: once a hang).
+  for (double factor : {1e21, 1e-22}) {
+    Surface scaled = surface;
+    for (Vec3& p : scaled.patches[1].control) p = factor * p;
+    expectMessageContains(validationError(scaled), {"patches[1]", "largest |coordinate|", "check the units"},
+                          "scale");
+  }
+  Surface large = surface;  // within the limits: accepted
+  for (Vec3& p : large.patches[0].control) p = 1e19 * p;
+  EXPECT_EQ(validationError(large), "");
 
   Surface zeroDegree = surface;
   zeroDegree.patches[0].degreeV = 0;

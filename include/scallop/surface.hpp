@@ -16,7 +16,8 @@
 // Contract
 // --------
 // A valid surface has at least one patch; each patch has degrees 1 <= m, n <=
-// kMaxPatchDegree, (m + 1)(n + 1) finite control points, and is regular: with
+// kMaxPatchDegree, (m + 1)(n + 1) finite control points whose largest |coordinate| lies in
+// [kMinPatchScale, kMaxPatchScale] (or is 0, rejected as singular below), and is regular: with
 // scale = the largest |coordinate| of its control points, |r_u x r_v| > tau = 1e-12 scale^2
 // at every (u, v) in [0, 1]^2, so that its unit normal (eq 2) is defined everywhere.
 // Degree 0 in a direction is rejected: r_u or r_v would vanish identically. (Accepted
@@ -84,6 +85,14 @@ struct Surface {
 /// Largest degree accepted in either direction. It bounds the cost of the regularity check,
 /// whose Bernstein form has (4m - 1)(4n - 1) coefficients.
 constexpr int kMaxPatchDegree = 20;
+
+/// The largest |coordinate| of a patch's control points must lie in [kMinPatchScale,
+/// kMaxPatchScale] (in the file's units). The curvature and certificate polynomials multiply
+/// up to a dozen coordinates (or their differences): beyond these they overflow or underflow
+/// (measured: 1e-25 and 1e30 work, 1e-30 and 1e300 do not; an error, not a hang, is the
+/// answer there). Real parts in inches or millimetres are many orders of magnitude inside.
+constexpr double kMinPatchScale = 1e-20;
+constexpr double kMaxPatchScale = 1e20;
 
 /// Quadtree limits of the regularity check (see the contract).
 constexpr int kRegularityMaxDepth = 16;
