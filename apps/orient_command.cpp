@@ -46,6 +46,7 @@ struct OrientOptions {
   std::string jsonPath;   // --json OUT
   std::string svgDir;     // --svg-dir DIR
   bool noCertify = false;  // --no-certify
+  bool latticeSeeds = false;  // --lattice-seeds
 };
 
 // Checks the combination of options, which CLI11 cannot express.
@@ -116,6 +117,7 @@ void runOrient(const OrientOptions& options) {
     slicingOptions.toleranceRad = toleranceDeg * (std::numbers::pi / 180.0);
   }
   slicingOptions.certify = !options.noCertify;
+  slicingOptions.latticeSeeds = options.latticeSeeds;
 
   const Surface surface = loadSurface(options.surface);
   const OptimalSlicing result = optimalSlicing(surface, slicingOptions);
@@ -180,6 +182,9 @@ void addOrientCommand(CLI::App& app) {
       ->type_name("DIR");
   orient->add_flag("--no-certify", options->noCertify,
                    "skip the Bernstein-form certificate (faster; \"certified\" is then false)");
+  orient->add_flag("--lattice-seeds", options->latticeSeeds,
+                   "also polish from the best directions of a fixed lattice of 2,000 (a "
+                   "safety net beside the medial axis; off: the paper's method alone)");
   orient->callback([options] { runOrient(*options); });
 }
 

@@ -909,6 +909,80 @@ bool mayVanish(const Bernstein2& p) {
          !std::all_of(p.coefficients.begin(), p.coefficients.end(), negative);
 }
 
+double EdgePowers::at(double u, double v) const {
+  return std::pow(u, u0) * std::pow(1.0 - u, u1) * std::pow(v, v0) * std::pow(1.0 - v, v1);
+}
+
+std::vector<Bernstein2> divideEdgeFactors(std::vector<Bernstein2> polynomials, double threshold,
+                                          EdgePowers& powers) {
+  powers = {};
+  if (polynomials.empty()) return polynomials;
+  const int m0 = polynomials.front().degreeU, n0 = polynomials.front().degreeV;
+  for (const Bernstein2& p : polynomials) {
+    if (p.degreeU != m0 || p.degreeV != n0) {
+      throw Error("divideEdgeFactors: the polynomials must share one bidegree");
+    }
+  }
+  // The dropped coefficients' bound, grown with each division as the kept ones are scaled
+  // (by at most the degree): rounding noise stays noise.
+  double level = threshold;
+  // Whether every polynomial's coefficients on one edge (row: the row i = index, an edge
+  // u = 0 or 1; else the column j = index, v = 0 or 1) are within the threshold of zero.
+  auto edgeVanishes = [&](bool row, int index) {
+    for (const Bernstein2& p : polynomials) {
+      const int count = row ? p.degreeV : p.degreeU;
+      for (int k = 0; k <= count; ++k) {
+        const double c = row ? p.at(index, k) : p.at(k, index);
+        if (!(std::abs(c) <= level)) return false;
+      }
+    }
+    return true;
+  };
+  // p / u (atStart) or p / (1 - u) along u (alongU), or the same along v.
+  auto divide = [](const Bernstein2& p, bool alongU, bool atStart) {
+    Bernstein2 q;
+    q.degreeU = p.degreeU - (alongU ? 1 : 0);
+    q.degreeV = p.degreeV - (alongU ? 0 : 1);
+    q.coefficients.resize(static_cast<std::size_t>(q.degreeU + 1) * static_cast<std::size_t>(q.degreeV + 1));
+    const int d = alongU ? p.degreeU : p.degreeV;
+    for (int i = 0; i <= q.degreeU; ++i) {
+      for (int j = 0; j <= q.degreeV; ++j) {
+        const int k = alongU ? i : j;  // the index along the divided direction
+        const double factor = atStart ? double(d) / (k + 1) : double(d) / (d - k);
+        const double c = atStart ? (alongU ? p.at(i + 1, j) : p.at(i, j + 1)) : p.at(i, j);
+        q.coefficients[static_cast<std::size_t>(i * (q.degreeV + 1) + j)] = c * factor;
+      }
+    }
+    return q;
+  };
+  for (bool progress = true; progress;) {
+    progress = false;
+    for (int side = 0; side < 4; ++side) {
+      const bool alongU = side < 2;
+      const bool atStart = side % 2 == 0;
+      const Bernstein2& p = polynomials.front();
+      const int degree = alongU ? p.degreeU : p.degreeV;
+      if (degree < 1) continue;
+      if (!edgeVanishes(alongU, atStart ? 0 : degree)) continue;
+      for (Bernstein2& q : polynomials) q = divide(q, alongU, atStart);
+      level *= degree;
+      int& power = side == 0 ? powers.u0 : side == 1 ? powers.u1 : side == 2 ? powers.v0 : powers.v1;
+      ++power;
+      progress = true;
+    }
+  }
+  // Nothing left above the noise (a net whose r_u x r_v vanishes identically, collapsed to a
+  // point or a line): exact zeros, not a direction made of rounding.
+  bool noise = true;
+  for (const Bernstein2& p : polynomials) {
+    for (double c : p.coefficients) noise = noise && std::abs(c) <= level;
+  }
+  if (noise) {
+    for (Bernstein2& p : polynomials) std::fill(p.coefficients.begin(), p.coefficients.end(), 0.0);
+  }
+  return polynomials;
+}
+
 Bernstein1 isoU(const Bernstein2& p, double u0) {
   requireValid(p, "isoU");
   Bernstein1 r{Coefficients(p.degreeV + 1)};

@@ -172,11 +172,10 @@ Vec3 normalVector(const BezierPatch& patch, double u, double v) {
   return cross(partial(patch, u, v, 1, 0), partial(patch, u, v, 0, 1));
 }
 
-Vec3 unitNormal(const BezierPatch& patch, double u, double v) {
-  requireValid(patch, "unitNormal");
+double normalRoundingThreshold(const BezierPatch& patch) {
+  requireValid(patch, "normalRoundingThreshold");
   const int m = patch.degreeU;
   const int n = patch.degreeV;
-  const Vec3 normal = cross(partial(patch, u, v, 1, 0), partial(patch, u, v, 0, 1));
   // S_u = m max|p_{j+1,k} - p_jk| >= |r_u| and likewise S_v >= |r_v| on the patch (m times a
   // convex combination of the differences). The computed r_u is within
   // gamma_{3(m+n)+2} S_u of the exact one (differences, de Casteljau, the degree factor),
@@ -193,14 +192,28 @@ Vec3 unitNormal(const BezierPatch& patch, double u, double v) {
   }
   const double su = std::sqrt(su2);
   const double sv = std::sqrt(sv2);
+  return (6.0 * (m + n) + 8.0) * kUnitRoundoff * (m * su) * (n * sv);
+}
+
+Vec3 unitNormal(const BezierPatch& patch, double u, double v) {
+  requireValid(patch, "unitNormal");
+  const Vec3 normal = cross(partial(patch, u, v, 1, 0), partial(patch, u, v, 0, 1));
   const double length = norm(normal);
-  const double threshold = (6.0 * (m + n) + 8.0) * kUnitRoundoff * (m * su) * (n * sv);
-  if (!(length > threshold)) {
-    throw Error(fmt::format(
-        "unitNormal: r_u x r_v vanishes at (u, v) = ({}, {}); the patch is not regular there", u,
-        v));
+  const double threshold = normalRoundingThreshold(patch);
+  if (length > threshold) return normal / length;
+  // On (or within rounding of) a collapsed edge the normal is the limit q / |q| of the
+  // direction field N = u^a (1 - u)^b v^c (1 - v)^d q (normalDirectionPolynomials): rare
+  // points, so the Bernstein forms are built here rather than kept.
+  const NormalDirection direction = normalDirectionPolynomials(patch);
+  if (direction.powers.any()) {
+    const double cu = std::clamp(u, 0.0, 1.0), cv = std::clamp(v, 0.0, 1.0);
+    const Vec3 q{evaluate(direction.polynomials[0], cu, cv), evaluate(direction.polynomials[1], cu, cv),
+                 evaluate(direction.polynomials[2], cu, cv)};
+    const double qLength = norm(q);
+    if (qLength > threshold) return q / qLength;
   }
-  return normal / length;
+  throw Error(fmt::format(
+      "unitNormal: r_u x r_v vanishes at (u, v) = ({}, {}); the patch is not regular there", u, v));
 }
 
 std::pair<BezierPatch, BezierPatch> subdivideU(const BezierPatch& patch, double t) {
@@ -258,6 +271,41 @@ Bernstein2 gaussianCurvatureNumerator(const BezierPatch& patch) {
   const Bernstein2 uu = dot(derivativesU(ru), normal);               // (3m - 3, 3n - 1)
   const Bernstein2 vv = dot(derivativesV(derivativesV(r)), normal);  // (3m - 1, 3n - 3)
   return subtract(multiply(uu, vv), mixedSquared);                   // (6m - 4, 6n - 4)
+}
+
+NormalDirection normalDirectionPolynomials(const BezierPatch& patch) {
+  NormalDirection out;
+  const std::array<Bernstein2, 3> normal = normalPolynomials(patch);
+  const std::vector<Bernstein2> quotients = divideEdgeFactors(
+      {normal[0], normal[1], normal[2]}, normalRoundingThreshold(patch), out.powers);
+  out.polynomials = {quotients[0], quotients[1], quotients[2]};
+  return out;
+}
+
+CurvatureSign curvatureSignPolynomial(const BezierPatch& patch) {
+  // As gaussianCurvatureNumerator, keeping the factors' sizes: a row or column of K's
+  // coefficients below 1e-12 of the terms' bound |r_uu . N| |r_vv . N| + |r_uv . N|^2 (their
+  // coefficients' largest magnitudes) vanishes but for rounding.
+  const std::array<Bernstein2, 3> r = coordinatePolynomials(patch);
+  const std::array<Bernstein2, 3> normal = normalPolynomials(patch);
+  const std::array<Bernstein2, 3> ru = derivativesU(r);
+  const Bernstein2 mixed = dot(derivativesV(ru), normal);
+  auto largest = [](const Bernstein2& p) {
+    double out = 0.0;
+    for (double c : p.coefficients) out = std::max(out, std::abs(c));
+    return out;
+  };
+  double termBound = largest(mixed) * largest(mixed);
+  Bernstein2 numerator = scale(multiply(mixed, mixed), -1.0);
+  if (patch.degreeU >= 2 && patch.degreeV >= 2) {
+    const Bernstein2 uu = dot(derivativesU(ru), normal);
+    const Bernstein2 vv = dot(derivativesV(derivativesV(r)), normal);
+    termBound += largest(uu) * largest(vv);
+    numerator = add(multiply(uu, vv), numerator);
+  }
+  CurvatureSign out;
+  out.polynomial = divideEdgeFactors({numerator}, 1e-12 * termBound, out.powers).front();
+  return out;
 }
 
 Bernstein2 normalLengthSquared(const BezierPatch& patch) {

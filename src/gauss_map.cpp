@@ -38,8 +38,14 @@ double angleBetween(const Vec3& a, const Vec3& b) {
 // Everything a patch needs for the Gauss map, computed once.
 struct PatchData {
   const BezierPatch* patch = nullptr;
-  std::array<Bernstein2, 3> normal;  // r_u x r_v, exact Bernstein form
-  Bernstein2 curvature;              // Gaussian curvature numerator (sign of K)
+  std::size_t index = 0;  // in the surface, for error messages
+  // r_u x r_v in exact Bernstein form, collapsed edges factored out (its limits there; see
+  // normalDirectionPolynomials).
+  std::array<Bernstein2, 3> normal;
+  // The Gaussian curvature numerator (sign of K), its edge factors split off (see
+  // curvatureSignPolynomial): a parabolic line along a patch edge is none here.
+  Bernstein2 curvature;
+  EdgePowers curvaturePowers;
   bool developable = false;          // K = 0 identically (to rounding)
   // Patch edges v = 0, u = 1, v = 1, u = 0 that another patch may share or touch (a seam):
   // there two patches' polygons of one curve must both be within the tolerance, or the
@@ -50,8 +56,10 @@ struct PatchData {
 PatchData makePatchData(const BezierPatch& patch) {
   PatchData data;
   data.patch = &patch;
-  data.normal = normalPolynomials(patch);
-  data.curvature = gaussianCurvatureNumerator(patch);
+  data.normal = normalDirectionPolynomials(patch).polynomials;
+  CurvatureSign sign = curvatureSignPolynomial(patch);
+  data.curvature = std::move(sign.polynomial);
+  data.curvaturePowers = sign.powers;
   // K's numerator is (r_uu . N)(r_vv . N) - (r_uv . N)^2, of the order of |N|^2 |r''|^2: call
   // it identically zero when every coefficient is below 1e-12 of that scale. |r''| is taken
   // at least 1e-6 |r'|: a plane whose control points carry rounding has second derivatives
@@ -315,12 +323,21 @@ class BoundaryBand {
 // within `tol` of the curve's point at the middle parameter, as the sphere chord's middle
 // is. The rule depends on the end parameters only (through the normals there and at the
 // middle), so two cells sampling a shared edge agree vertex for vertex.
+// Work bounds: halvings of one curve of normals (the paper's surfaces need a few hundred at
+// 0.5 degree, ~30,000 at 4e-7 degree), and quadtree cells of one patch (40 to 90 on the
+// paper's surfaces, ~600 on a teapot patch at the finest tolerance). Past them the map
+// stops with an error naming the patch.
+constexpr std::size_t kMaxCurveSamples = std::size_t{1} << 21;
+constexpr std::size_t kMaxPatchCells = std::size_t{1} << 20;
+
 struct NormalSampler {
   double tol;
   Rotation3 toPoleFrame;
   // Optional: away from `band` (deep inside Omega) the polygon is held within `coarseTol`.
   const BoundaryBand* band = nullptr;
   double coarseTol = 0.0;
+
+  mutable std::size_t samples = 0;  // halvings of the current curve (see kMaxCurveSamples)
 
   double maxStep() const { return std::max(64.0 * tol, 0.05); }
 
@@ -365,6 +382,14 @@ struct NormalSampler {
       if (parameters != nullptr) parameters->push_back(s1);
       return;
     }
+    // Bounded work: a curve the halving cannot resolve (rounding noise in a traced root, a
+    // normal that turns without end) stops with an error, never an exponential run.
+    if (++samples > kMaxCurveSamples) {
+      throw Error(fmt::format("the Gauss map could not sample a curve of normals to the "
+                              "tolerance within {} points (the normal turns too fast, or is "
+                              "rounding noise, near parameter {} of a cell edge or a "
+                              "parabolic line)", kMaxCurveSamples, sm));
+    }
     refine(normalAt, s0, sm, n0, nm, depth + 1, out, parameters);
     refine(normalAt, sm, s1, nm, n1, depth + 1, out, parameters);
   }
@@ -372,6 +397,7 @@ struct NormalSampler {
   // The samples n(0), ..., n(1); their parameters s in `parameters` when given.
   std::vector<Vec3> curve(const std::function<Vec3(double)>& normalAt,
                           std::vector<double>* parameters = nullptr) const {
+    samples = 0;
     std::vector<Vec3> out{normalAt(0.0)};
     if (parameters != nullptr) parameters->assign(1, 0.0);
     refine(normalAt, 0.0, 1.0, out.front(), normalAt(1.0), 0, out, parameters);
@@ -397,6 +423,7 @@ struct NormalSampler {
 // ---------------------------------------------------------------------------------------
 
 constexpr double kRegularCellSpread = 0.5;  // radians
+
 
 // The coarse map of the band (see symmetrizedGaussMap): its tolerance (radians), used when
 // the tolerance asked for is at least kCoarseBandFactor times finer; the band's half-width
@@ -551,6 +578,11 @@ struct CellBuilder {
       cells.push_back({u0, u1, v0, v1, true, centre, spread, 0});
       return;
     }
+    if (cells.size() >= kMaxPatchCells) {
+      throw Error(fmt::format("the Gauss map's quadtree reached {} cells without resolving the "
+                              "parabolic lines near (u, v) = ({}, {})",
+                              kMaxPatchCells, 0.5 * (u0 + u1), 0.5 * (v0 + v1)));
+    }
     const double um = 0.5 * (u0 + u1);
     const double vm = 0.5 * (v0 + v1);
     auto [left, right] = subdivideU(k, 0.5);
@@ -587,6 +619,9 @@ struct CellBuilder {
   // The Gaussian curvature numerator (r_uu . N)(r_vv . N) - (r_uv . N)^2 at (u, v), from the
   // patch's derivatives: the polynomial `data.curvature`, evaluated cheaply.
   double curvatureAt(double u, double v) const {
+    // With edge factors split off, the polynomial itself: the numerator divided by them
+    // would be noise beside those edges.
+    if (data.curvaturePowers.any()) return evaluate(data.curvature, u, v);
     return gaussianCurvatureNumeratorAt(*data.patch, u, v);
   }
 
@@ -1197,7 +1232,18 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
   if (surface.patches.empty()) throw Error("the surface has no patches");
   GaussMap map;
   std::vector<PatchData> patches;
-  for (const BezierPatch& p : surface.patches) patches.push_back(makePatchData(p));
+  for (const BezierPatch& p : surface.patches) {
+    patches.push_back(makePatchData(p));
+    patches.back().index = patches.size() - 1;
+  }
+  // Errors from one patch's quadtree or sampling name the patch.
+  auto inPatch = [](const PatchData& data, const auto& work) {
+    try {
+      work();
+    } catch (const Error& e) {
+      throw Error(fmt::format("patches[{}]: {}", data.index, e.what()));
+    }
+  };
   markSeams(patches);
 
   // At fine tolerances, a coarse map first: curves farther than a band around its boundary
@@ -1224,7 +1270,7 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
       continue;
     }
     builders.push_back(CellBuilder{data, tol, options.maxCellDepth, {}, nullptr, {}});
-    builders.back().run();
+    inPatch(data, [&] { builders.back().run(); });
   }
   const bool allDevelopable = builders.empty();
 
@@ -1243,7 +1289,22 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
       if (!list[i].fold && area > poleArea) poleBuilder = b, poleIndex = i, poleArea = area;
     }
   }
-  map.pole = poleBuilder < builders.size() ? builders[poleBuilder].cells[poleIndex].centre : first;
+  // The pole is the cell's centre normal, or with options.offsetPole the normal at a point
+  // with irrational-looking offsets: a dyadic centre's normal can be exactly the normal at a
+  // point of another cell's (dyadic) edge on surfaces with symmetries (a surface of
+  // revolution repeats its normals' latitudes along every meridian). The pole on an edge's
+  // image puts that edge's polygon through the projection's point at infinity (the teapot's
+  // lower body lost its whole complement so); optimalSlicing retries with the offset pole
+  // when the complement comes out empty.
+  if (poleBuilder < builders.size()) {
+    const Cell& c = builders[poleBuilder].cells[poleIndex];
+    const double kPoleOffsetU = options.offsetPole ? 0.4142135623730950 : 0.5;  // sqrt(2) - 1
+    const double kPoleOffsetV = options.offsetPole ? 0.5811388300841898 : 0.5;  // sqrt(10)/2 - 1
+    map.pole = unitNormal(*builders[poleBuilder].data.patch, c.u0 + kPoleOffsetU * (c.u1 - c.u0),
+                          c.v0 + kPoleOffsetV * (c.v1 - c.v0));
+  } else {
+    map.pole = first;
+  }
   map.toPoleFrame = rotationTaking(map.pole, {0.0, 0.0, 1.0});
 
   const NormalSampler sampler{tol, map.toPoleFrame};
@@ -1270,13 +1331,15 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
     std::vector<CellImage> images;
     CellBuilder::ImageStats stats;
     for (int run = 0; run < 64; ++run) {
-      if (rerun) {
-        builder.cells.clear();
-        builder.run();
-      }
       std::vector<CellBuilder::CellBounds> untraceable;
-      stats = {};
-      images = builder.images(sampler, inner, stats, untraceable);
+      inPatch(builder.data, [&] {
+        if (rerun) {
+          builder.cells.clear();
+          builder.run();
+        }
+        stats = {};
+        images = builder.images(sampler, inner, stats, untraceable);
+      });
       imageStats.untracedCells += untraceable.size();  // over every run
       if (untraceable.empty()) break;
       builder.noTrace.insert(untraceable.begin(), untraceable.end());

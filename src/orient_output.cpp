@@ -56,6 +56,9 @@ Json documentJson(const OptimalSlicing& result, double toleranceDeg) {
   document["certified"] = result.certified;
   document["certified_alpha_deg"] = toDegrees(result.certifiedAlphaRad);
   document["certificate_cells"] = result.certificateCells;
+  // The polish's angle that the certificate refuted, when it did (alpha_deg is then proven).
+  document["refuted_alpha_deg"] =
+      result.uncertifiedAlphaRad > 0.0 ? Json(toDegrees(result.uncertifiedAlphaRad)) : Json(nullptr);
   document["method"] = result.method;
   if (result.method == "medial-axis") {
     Json circle;

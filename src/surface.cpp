@@ -219,13 +219,26 @@ PatchRegularity checkPatchRegularity(const BezierPatch& original) {
   PatchRegularity result;
   result.threshold = kRelativeNormalTolerance;
   const double tau = kRelativeNormalTolerance * scale * scale;
-  const double bound = derivativeBoundProduct(patch);
+  // N's direction field, collapsed edges (apex rows) factored out: the patch is regular when
+  // q is nowhere zero on the closed patch, its unit normal then continuous up to those edges
+  // (their limits). Each division by u, say, multiplies coefficients by up to the degree, so
+  // the rounding slacks below take S_u S_v times that factor per division.
+  const NormalDirection direction = normalDirectionPolynomials(patch);
+  const EdgePowers& powers = direction.powers;
+  const double bound = derivativeBoundProduct(patch) *
+                       std::pow(std::max(patch.degreeU, patch.degreeV),
+                                powers.u0 + powers.u1 + powers.v0 + powers.v1);
 
   double least = std::numeric_limits<double>::infinity();
-  // Evaluates |r_u x r_v| at (u, v); returns true if it is small enough to prove the patch
-  // singular there. Keeps the least value seen as the location of an undecided verdict.
+  // Evaluates |q| (|r_u x r_v| without collapsed edges) at (u, v); returns true if it is
+  // small enough to prove the patch singular there. Keeps the least value seen as the
+  // location of an undecided verdict.
   auto probe = [&](double u, double v) {
-    const double length = normalLengthAt(patch, u, v);
+    const double length =
+        powers.any() ? norm(Vec3{evaluate(direction.polynomials[0], u, v),
+                                 evaluate(direction.polynomials[1], u, v),
+                                 evaluate(direction.polynomials[2], u, v)})
+                     : normalLengthAt(patch, u, v);
     if (length < least) {
       least = length;
       result.u = u;
@@ -237,8 +250,9 @@ PatchRegularity checkPatchRegularity(const BezierPatch& original) {
 
   // Breadth first, one level at a time, so that the cell budget is spent evenly.
   std::vector<Cell> level(1);
-  level[0].f = normalLengthSquared(patch);
-  level[0].normal = normalPolynomials(patch);
+  const std::array<Bernstein2, 3>& q = direction.polynomials;
+  level[0].f = add(add(multiply(q[0], q[0]), multiply(q[1], q[1])), multiply(q[2], q[2]));
+  level[0].normal = q;
   for (int depth = 0; !level.empty(); ++depth) {
     // A cell is proven regular (|N| > tau on it, beyond rounding) when f's coefficients all
     // exceed proofSquared, or the coefficients of d . N all exceed proofDirectional.

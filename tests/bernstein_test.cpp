@@ -1297,3 +1297,58 @@ TEST(Bernstein2Bounds, BoundsMayVanishAndIsoLines) {
 }
 
 }  // namespace
+
+// divideEdgeFactors against multiplication: q times u^a (1 - u)^b v^c (1 - v)^d (built by
+// Bernstein products of the linear factors), divided, gives q back and the exponents; the
+// quotient agrees with p / factors pointwise inside the square. A polynomial with no factor
+// comes back unchanged, and the zero polynomial stops at degree 0.
+TEST(BernsteinEdgeFactors, DivisionUndoesMultiplication) {
+  std::mt19937_64 rng(11);
+  std::uniform_int_distribution<int> power(0, 2);
+  const Bernstein2 u{1, 0, {0.0, 1.0}}, oneMinusU{1, 0, {1.0, 0.0}};
+  const Bernstein2 v{0, 1, {0.0, 1.0}}, oneMinusV{0, 1, {1.0, 0.0}};
+  for (int trial = 0; trial < 400; ++trial) {
+    const int m = 1 + trial % 5, n = 1 + (trial / 5) % 5;
+    Bernstein2 q = randomBernstein2(rng, m, n);
+    // Keep q's own edges away from zero so that no further factor divides it.
+    for (double& c : q.coefficients) c = c >= 0.0 ? c + 0.5 : c - 0.5;
+    const scallop::EdgePowers want{power(rng), power(rng), power(rng), power(rng)};
+    Bernstein2 p = q;
+    for (int i = 0; i < want.u0; ++i) p = scallop::multiply(p, u);
+    for (int i = 0; i < want.u1; ++i) p = scallop::multiply(p, oneMinusU);
+    for (int i = 0; i < want.v0; ++i) p = scallop::multiply(p, v);
+    for (int i = 0; i < want.v1; ++i) p = scallop::multiply(p, oneMinusV);
+    scallop::EdgePowers got;
+    const Bernstein2 quotient = scallop::divideEdgeFactors({p}, 1e-13, got).front();
+    // Edge rows of p built by multiplication are exact zeros, and q's are not small: the
+    // exponents are exact.
+    EXPECT_EQ(got.u0, want.u0) << trial;
+    EXPECT_EQ(got.u1, want.u1) << trial;
+    EXPECT_EQ(got.v0, want.v0) << trial;
+    EXPECT_EQ(got.v1, want.v1) << trial;
+    ASSERT_EQ(quotient.degreeU, q.degreeU);
+    ASSERT_EQ(quotient.degreeV, q.degreeV);
+    for (int s = 0; s < 10; ++s) {
+      const double a = 0.05 + 0.9 * std::uniform_real_distribution<double>(0.0, 1.0)(rng);
+      const double b = 0.05 + 0.9 * std::uniform_real_distribution<double>(0.0, 1.0)(rng);
+      const double expected = scallop::evaluate(q, a, b);
+      EXPECT_NEAR(scallop::evaluate(quotient, a, b), expected, 1e-12 * (1.0 + std::abs(expected)));
+      EXPECT_NEAR(scallop::evaluate(p, a, b) / got.at(a, b), expected, 1e-9 * (1.0 + std::abs(expected)));
+    }
+  }
+  // Nothing to divide.
+  std::mt19937_64 rng2(3);
+  Bernstein2 plain = randomBernstein2(rng2, 3, 4);
+  for (double& c : plain.coefficients) c += 5.0;
+  scallop::EdgePowers none;
+  EXPECT_EQ(scallop::divideEdgeFactors({plain}, 1e-13, none).front().coefficients, plain.coefficients);
+  EXPECT_FALSE(none.any());
+  // Zero: every edge vanishes; degrees stop at 0.
+  const Bernstein2 zero{3, 2, std::vector<double>(12, 0.0)};
+  scallop::EdgePowers all;
+  const Bernstein2 rest = scallop::divideEdgeFactors({zero}, 0.0, all).front();
+  EXPECT_EQ(rest.degreeU, 0);
+  EXPECT_EQ(rest.degreeV, 0);
+  // Polynomials of different bidegrees are refused.
+  EXPECT_THROW(scallop::divideEdgeFactors({zero, plain}, 0.0, all), scallop::Error);
+}

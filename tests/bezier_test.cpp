@@ -415,18 +415,69 @@ TEST(BezierNormal, DegeneratePatchesThrow) {
     EXPECT_NE(std::string(error.what()).find("(u, v) = (0.25, 0.75)"), std::string::npos)
         << error.what();
   }
-  // A collapsed row (p_0k all equal, a triangular patch): r_v = 0 along u = 0 only.
+  // A collapsed row (p_0k all equal, a triangular patch): r_v = 0 along u = 0 only, where
+  // unitNormal gives the limit from inside (below).
   BezierPatch apex = graphPatch(rng, 3, 3, 0.5, false);
   for (int k = 0; k <= 3; ++k) apex.control[k] = {0.0, 1.5, 0.0};
   for (int trial = 0; trial < 100; ++trial) {
     const double v = randomUnit(rng);
-    EXPECT_THROW(scallop::unitNormal(apex, 0.0, v), scallop::Error);
+    EXPECT_NO_THROW(scallop::unitNormal(apex, 0.0, v));
     EXPECT_NO_THROW(scallop::unitNormal(apex, 0.5 + 0.5 * randomUnit(rng), v));
   }
   const Bernstein2 lengthSquared = scallop::normalLengthSquared(apex);
   EXPECT_TRUE(scallop::mayVanish(lengthSquared));
   // Its u = 0 row is exactly zero (products of row-0 coefficients only, and r_v's vanish).
   EXPECT_TRUE(scallop::isZero(scallop::isoU(lengthSquared, 0.0)));
+}
+
+// The normal on a collapsed edge is the limit of the normals from inside: against
+// unitNormal at u = 1e-7 (where r_u x r_v is small but well above rounding), on random patches
+// with a collapsed row at u = 0 or u = 1 or a collapsed column, and on a cone's apex, where
+// the limits differ from ray to ray.
+TEST(BezierNormal, CollapsedEdgesTakeTheLimitFromInside) {
+  std::mt19937_64 rng(7);
+  for (int trial = 0; trial < 300; ++trial) {
+    BezierPatch p = graphPatch(rng, 2 + trial % 3, 2 + (trial / 3) % 3, 0.5, false);
+    const int side = trial % 4;  // 0: u = 0, 1: u = 1, 2: v = 0, 3: v = 1
+    const Vec3 corner = side < 2 ? p.at(side == 0 ? 0 : p.degreeU, 1) : p.at(1, side == 2 ? 0 : p.degreeV);
+    for (int j = 0; j <= p.degreeU; ++j) {
+      for (int k = 0; k <= p.degreeV; ++k) {
+        const bool onEdge = side == 0 ? j == 0 : side == 1 ? j == p.degreeU : side == 2 ? k == 0 : k == p.degreeV;
+        if (onEdge) p.control[static_cast<std::size_t>(j * (p.degreeV + 1) + k)] = corner;
+      }
+    }
+    const scallop::NormalDirection direction = scallop::normalDirectionPolynomials(p);
+    EXPECT_TRUE(direction.powers.any()) << trial;
+    for (int i = 0; i < 8; ++i) {
+      const double t = 0.05 + 0.9 * randomUnit(rng);
+      const double e = 1e-7;
+      const double u = side == 0 ? 0.0 : side == 1 ? 1.0 : t, v = side == 2 ? 0.0 : side == 3 ? 1.0 : t;
+      const double ui = side == 0 ? e : side == 1 ? 1.0 - e : t, vi = side == 2 ? e : side == 3 ? 1.0 - e : t;
+      Vec3 limit, inside;
+      try {
+        limit = scallop::unitNormal(p, u, v);
+        inside = scallop::unitNormal(p, ui, vi);
+      } catch (const scallop::Error&) {
+        continue;  // a random net can also be singular elsewhere on the edge (q = 0 there)
+      }
+      EXPECT_LT(scallop::norm(limit - inside), 1e-5) << "trial " << trial << " t " << t;
+    }
+  }
+  // A cone over a quarter circle (rational-free: the circle's cubic approximation), apex at
+  // the origin: along each ray v the normal is constant, so the limit at the apex is that
+  // ray's normal and varies with v.
+  BezierPatch cone{3, 3, {}};
+  const double kappa = 0.5522847498;
+  const Vec3 ring[4] = {{1, 0, -1}, {1, kappa, -1}, {kappa, 1, -1}, {0, 1, -1}};
+  for (int j = 0; j <= 3; ++j) {
+    for (int k = 0; k <= 3; ++k) cone.control.push_back((j / 3.0) * ring[k]);
+  }
+  for (double v : {0.0, 0.2, 0.5, 0.9, 1.0}) {
+    const Vec3 apexNormal = scallop::unitNormal(cone, 0.0, v);
+    const Vec3 rayNormal = scallop::unitNormal(cone, 0.6, v);
+    EXPECT_LT(scallop::norm(apexNormal - rayNormal), 1e-12) << v;
+  }
+  EXPECT_GT(scallop::norm(scallop::unitNormal(cone, 0.0, 0.0) - scallop::unitNormal(cone, 0.0, 1.0)), 0.5);
 }
 
 // ---------------------------------------------------------------------------------------

@@ -113,7 +113,8 @@ TEST(OrientJson, EveryKeyInOrderAndEveryNumberBitForBit) {
     for (const auto& item : ordered.items()) keys.push_back(item.key());
     EXPECT_EQ(keys, (std::vector<std::string>{
                         "normal", "alpha_deg", "certified", "certified_alpha_deg",
-                        "certificate_cells", "method", "circle", "sphere_circle", "pole",
+                        "certificate_cells", "refuted_alpha_deg", "method", "circle",
+                        "sphere_circle", "pole",
                         "tolerance_deg", "gauss_map", "medial_axis", "seconds"}));
     std::vector<std::string> medialKeys;
     for (const auto& item : ordered.at("medial_axis").items()) medialKeys.push_back(item.key());

@@ -487,28 +487,39 @@ TEST(Surface, RejectsCollinearControlPoints) {
   expectMessageContains(message, {"s.json: patches[1]", "degenerate", "(u, v) = ("}, "collinear");
 }
 
-// A collapsed boundary row: p_0k all equal, so r(0, v) is one point, r_v = 0 along u = 0
-// and the normal is undefined along that edge (as at the apex of a degenerate triangular
-// patch). Likewise a collapsed column k = 3 makes r_u vanish along v = 1.
-TEST(Surface, RejectsCollapsedBoundaryRowOrColumn) {
+// A collapsed boundary row: p_0k all equal, so r(0, v) is one point (an apex) and r_v = 0
+// along u = 0; likewise a collapsed column k = 3 makes r_u vanish along v = 1. The normal has
+// a limit there (bezier.hpp's normalDirectionPolynomials), so the patch is regular. A net
+// collapsed to one point, or with a second collapsed edge that leaves no limit, is not.
+TEST(Surface, AcceptsCollapsedBoundaryRowOrColumn) {
   const BezierPatch row = makePatch(3, 3, [](int j, int k) {
     return j == 0 ? Vec3{1.5, 0.0, 0.7}
                   : Vec3{static_cast<double>(k), static_cast<double>(j), 0.1 * j * k};
   });
-  PatchRegularity regularity = checkPatchRegularity(row);
-  EXPECT_EQ(regularity.verdict, RegularityVerdict::singular);
-  EXPECT_EQ(regularity.u, 0.0);
+  EXPECT_EQ(checkPatchRegularity(row).verdict, RegularityVerdict::regular);
   Surface surface;
   surface.patches = {row};
-  expectMessageContains(parseError(surfaceToJson(surface)),
-                        {"s.json: patches[0]", "degenerate", "(u, v) = (0, "}, "collapsed row");
+  EXPECT_NO_THROW(validateSurface(surface));
 
   const BezierPatch column = makePatch(3, 3, [](int j, int k) {
-    return k == 3 ? Vec3{3.0, 1.5, 0.0} : Vec3{static_cast<double>(k), static_cast<double>(j), 0.0};
+    return k == 3 ? Vec3{3.0, 1.5, 0.0}
+                  : Vec3{static_cast<double>(k), static_cast<double>(j), 0.05 * j * j - 0.1 * k};
   });
-  regularity = checkPatchRegularity(column);
-  EXPECT_EQ(regularity.verdict, RegularityVerdict::singular);
-  EXPECT_EQ(regularity.v, 1.0);
+  EXPECT_EQ(checkPatchRegularity(column).verdict, RegularityVerdict::regular);
+
+  const BezierPatch point = makePatch(3, 3, [](int, int) { return Vec3{1.0, 2.0, 3.0}; });
+  EXPECT_NE(checkPatchRegularity(point).verdict, RegularityVerdict::regular);
+  surface.patches = {point};
+  expectMessageContains(parseError(surfaceToJson(surface)), {"s.json: patches[0]", "degenerate"},
+                        "one point");
+  // Rows 0 and 3 both collapsed to the same point: a closed, pinched net whose normal along
+  // both rows needs more than one factor; the u = 0 and u = 1 limits exist, but the v-edges
+  // then run through the apex twice. Whatever the verdict, it must not throw.
+  const BezierPatch pinched = makePatch(3, 3, [](int j, int k) {
+    return j == 0 || j == 3 ? Vec3{0.0, 0.0, 0.0}
+                            : Vec3{static_cast<double>(k), static_cast<double>(j) - 1.5, 0.3 * k};
+  });
+  EXPECT_NO_THROW(checkPatchRegularity(pinched));
 }
 
 // Each row a cubic with p_0 = p_3 and p_1 = p_2: r_v = 0 along the interior line v = 1/2
@@ -655,7 +666,7 @@ TEST(Surface, SingularVerdictsAreBackedByTheThreshold) {
   for (const double pinch : {1.0, 1e-2, 1e-4, 1e-6, 1e-8, 1e-10, 1e-11, 1e-12, 1e-13, 0.0}) {
     // Row 0 shrinks toward one point as pinch -> 0: r_v along u = 0 is pinch times a row.
     const BezierPatch patch = makePatch(3, 3, [&](int j, int k) {
-      const double width = j == 0 ? pinch : 1.0;
+      const double width = j == 0 ? pinch : 1.0;  // pinch 0: an apex row
       return Vec3{1.5 + width * (k - 1.5), static_cast<double>(j), 0.2 * j};
     });
     const PatchRegularity regularity = checkPatchRegularity(patch);
@@ -668,7 +679,12 @@ TEST(Surface, SingularVerdictsAreBackedByTheThreshold) {
     if (pinch >= 1e-11) {
       EXPECT_EQ(regularity.verdict, RegularityVerdict::regular) << pinch;
     }
-    if (pinch <= 1e-13) {
+    if (pinch == 0.0) {
+      // Collapsed to one point exactly: an apex, with the normal's limit there.
+      EXPECT_EQ(regularity.verdict, RegularityVerdict::regular) << pinch;
+    } else if (pinch <= 1e-13) {
+      // Nearly collapsed, above rounding: r_u x r_v is small but no factor, and within the
+      // threshold on that edge.
       EXPECT_EQ(regularity.verdict, RegularityVerdict::singular) << pinch;
     }
   }

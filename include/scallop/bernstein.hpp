@@ -195,6 +195,32 @@ Bounds bounds(const Bernstein2& p);
 /// False when every coefficient is > 0 or every coefficient is < 0, which proves p has no
 /// zero on [0, 1]^2; true otherwise (p may vanish). The test of a quadtree on the zero set.
 bool mayVanish(const Bernstein2& p);
+/// Exponents of the edge factors u^u0 (1 - u)^u1 v^v0 (1 - v)^v1 split off polynomials by
+/// divideEdgeFactors.
+struct EdgePowers {
+  int u0 = 0;  ///< the power of u (the edge u = 0)
+  int u1 = 0;  ///< the power of 1 - u (the edge u = 1)
+  int v0 = 0;  ///< the power of v (the edge v = 0)
+  int v1 = 0;  ///< the power of 1 - v (the edge v = 1)
+  bool any() const { return u0 + u1 + v0 + v1 > 0; }
+  /// u^u0 (1 - u)^u1 v^v0 (1 - v)^v1 at (u, v).
+  double at(double u, double v) const;
+};
+
+/// Divides polynomials of one bidegree by the edge factors they share: while every one of
+/// them has its coefficients on the edge u = 0 (the row c_0j) at most `threshold` in
+/// magnitude, they all vanish on that edge to within it, and p = u q with
+/// q_ij = c_(i+1)j m / (i + 1) (b_(i+1)^m(u) = (m / (i + 1)) u b_i^(m-1)(u)); likewise
+/// 1 - u (c_ij m / (m - i), the row c_mj dropped), v and 1 - v. The bound grows by the
+/// degree with each division (the kept coefficients are scaled by up to it, and so is their
+/// noise). Exact but for the dropped coefficients and one rounding per coefficient and
+/// division; a degree never drops below 0, and quotients whose every coefficient is within
+/// the grown bound (rounding noise of a polynomial that vanishes identically) are returned
+/// as exact zeros. Returns the quotients; `powers` receives the exponents split off.
+/// O(k mn) for k divisions.
+std::vector<Bernstein2> divideEdgeFactors(std::vector<Bernstein2> polynomials, double threshold,
+                                          EdgePowers& powers);
+
 /// The iso-parameter line u = u0: v -> p(u0, v), degree n (for patch boundaries: u0 = 0, 1).
 Bernstein1 isoU(const Bernstein2& p, double u0);
 /// The iso-parameter line v = v0: u -> p(u, v0), degree m (for patch boundaries: v0 = 0, 1).

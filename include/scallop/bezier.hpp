@@ -77,7 +77,9 @@ Vec3 derivativeV(const BezierPatch& patch, double u, double v);
 Vec3 secondDerivative(const BezierPatch& patch, double u, double v, int du, int dv);
 /// r_u x r_v, not normalised (zero where the patch is not regular).
 Vec3 normalVector(const BezierPatch& patch, double u, double v);
-/// The unit normal of eq. (2); throws scallop::Error naming (u, v) where r_u x r_v vanishes.
+/// The unit normal of eq. (2); on a collapsed edge (an apex row), its limit from inside the
+/// patch (normalDirectionPolynomials); throws scallop::Error naming (u, v) where r_u x r_v
+/// vanishes otherwise.
 Vec3 unitNormal(const BezierPatch& patch, double u, double v);
 
 /// r_u, r_v, r_uu, r_uv and r_vv at one point, from the Bernstein basis and its derivatives
@@ -107,5 +109,37 @@ std::array<Bernstein2, 3> normalPolynomials(const BezierPatch& patch);
 Bernstein2 gaussianCurvatureNumerator(const BezierPatch& patch);
 /// |r_u x r_v|^2, bidegree (4m - 2, 4n - 2).
 Bernstein2 normalLengthSquared(const BezierPatch& patch);
+
+/// The normal's direction field with collapsed edges factored out: N = r_u x r_v =
+/// u^a (1 - u)^b v^c (1 - v)^d q, where a boundary row or column of the control net collapses
+/// to a point (an apex: r_v = 0 along u = 0, say) N vanishes on that edge and the limit of
+/// the unit normal there is q / |q|. q is N divided by the edge factors under which all three
+/// components vanish to within unitNormal's rounding threshold (bernstein.hpp's
+/// divideEdgeFactors); q = N (powers zero) for a patch with no such edge. q is parallel to N,
+/// with the same sense, wherever N != 0, so every use of N's direction (the Gauss map, the
+/// certificate, the membership test) takes q alike. Where q itself vanishes on the closed
+/// patch (a corner where the limit depends on the direction of approach, or an interior
+/// singularity) the patch is not regular (surface.hpp).
+struct NormalDirection {
+  std::array<Bernstein2, 3> polynomials;
+  EdgePowers powers;
+};
+NormalDirection normalDirectionPolynomials(const BezierPatch& patch);
+
+/// The sign of the Gaussian curvature as a polynomial: gaussianCurvatureNumerator = K |N|^4
+/// divided by the edge factors on which it vanishes (every coefficient of the edge's row
+/// below 1e-12 of the bound on its terms, |r_uu . N| |r_vv . N| + |r_uv . N|^2): collapsed
+/// edges (N = u^a q there, so K |N|^4 has u^(2a) at least), and parabolic lines that run
+/// along a patch edge (the rim of a surface of revolution whose profile has an inflection at
+/// its end). Inside the patch its sign is K's; on such an edge it is the sign of K's limit
+/// from inside, so the edge is no parabolic line for the Gauss map's quadtree.
+struct CurvatureSign {
+  Bernstein2 polynomial;
+  EdgePowers powers;
+};
+CurvatureSign curvatureSignPolynomial(const BezierPatch& patch);
+
+/// unitNormal's threshold: |r_u x r_v| at most (6(m + n) + 8) u S_u S_v is rounding noise.
+double normalRoundingThreshold(const BezierPatch& patch);
 
 }  // namespace scallop

@@ -43,8 +43,20 @@
 //         projected boundary, decided by the membership test below) on an integer grid of
 //         2^29 steps across the pole cell's loop, and the complement is what remains inside
 //         that loop, shrunk by two grid steps so that no two of its loops touch.
-//         The pole is the centre normal of the largest regular cell; a traced cell that might
-//         hold it is subdivided instead.
+//         Pole: the centre normal of the largest regular cell (with offsetPole, the normal at
+//         irrational-looking offsets from its corners: a symmetric surface, such as a surface
+//         of revolution, can repeat the centre's normal on other cells' dyadic edges, and the
+//         pole on an edge's image sends that polygon through infinity); a traced cell that
+//         might hold it is subdivided instead.
+// Edges:  the curvature sign is taken from K's numerator with its edge factors split off
+//         (bezier.hpp's curvatureSignPolynomial): a parabolic line that runs along a patch
+//         edge (a surface of revolution whose profile has an inflection at its end, as the
+//         teapot's upper body) is then no fold for the quadtree, and the normal's direction
+//         from r_u x r_v with collapsed edges (apexes) factored out (normalDirectionPolynomials):
+//         the image of a collapsed edge is the curve of its limit normals (a point for a
+//         smooth apex, an arc for a cone's).
+// Work:   bounded: at most 2^21 halvings per sampled curve and 2^20 quadtree cells per
+//         patch; past them scallop::Error names the patch and the place.
 // Coarse band: below delta = 2e-4 / 16 rad, a map at 2e-4 rad comes first, and curves (arcs,
 //         patch edges that no other patch touches) farther than 4 coarse tolerances from its
 //         boundary are sampled to 2e-4 rad only: they lie deep inside Omega, and their
@@ -120,6 +132,10 @@ struct GaussMapOptions {
   /// At tolerances finer than 1/16 of 2e-4 rad, sample curves of normals deep inside Omega
   /// (farther than a band around a coarse map's boundary) to the coarse tolerance only.
   bool coarseBand = true;
+  /// Take the pole at an off-centre point of its cell (irrational-looking offsets) instead of
+  /// the centre: on symmetric surfaces the centre's normal can lie on another cell's edge
+  /// image (see the contract, Pole); optimalSlicing retries so when the complement is empty.
+  bool offsetPole = false;
 };
 
 enum class GaussMapKind {

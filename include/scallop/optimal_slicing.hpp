@@ -21,9 +21,8 @@
 //         in (0, 1) of eq (13), built in Bernstein form with R^2 for R (degree 4 for linear
 //         edges, 8 for parabolic ones) -> the best circle gives N* by eq (14), rotated back
 //         from the pole frame -> the polish: from that circle and up to three rivals within
-//         4 tolerances of it (more than a degree apart), and from the four best of a
-//         lattice of 2,000 directions (a safety net against a Gauss map that misses
-//         normals, which the medial axis cannot see; the medial axis's seeds win ties), the
+//         4 tolerances of it (more than a degree apart) (and, with latticeSeeds, from the
+//         four best of a lattice of 2,000 directions; the medial axis's seeds win ties), the
 //         minimax problem min_N max |n . N| is solved on the true surface by a trust-region
 //         SQP method: the contacts (local maxima of |n . N| over each patch, interior, on
 //         an edge or at a corner) by Newton's method from warm starts and a fixed 33 x 33
@@ -95,6 +94,11 @@ struct OptimalSlicingOptions {
   /// axis to another basin. ~4e-7 degree gives ~100,000 segments on either surface.
   double toleranceRad = 0.5 * std::numbers::pi / 180.0;
   bool certify = true;  ///< run the Bernstein-form certificate
+  /// false (the default): the polish starts from the medial axis's circles alone, the
+  /// paper's method. true: also from the four best directions of a fixed lattice of 2,000
+  /// (rated on sampled normals), a safety net against a Gauss map that loses normals; the
+  /// tests show it changes no answer on their surfaces (the teapot's included).
+  bool latticeSeeds = false;
   /// true: the medial-axis search runs coarse-to-fine on large domains (bestCircles; the
   /// same circle, much faster); false: always on the full-resolution domain (for
   /// comparison and tests).
@@ -109,6 +113,10 @@ struct OptimalSlicing {
   Vec3 pole;               ///< the surface normal used as the pole
   bool certified = false;  ///< proven: no normal within certifiedAlphaRad of +-N*
   double certifiedAlphaRad = 0.0;  ///< the angle the certificate proves (alpha* - 1e-7 rad)
+  /// When the certificate refuted the polish's alpha (a normal nearer to N* than its contacts
+  /// showed), that refuted value; alphaRad is then the largest angle the certificate proves
+  /// at N* (by bisection), so an uncertified angle is never the answer. 0 otherwise.
+  double uncertifiedAlphaRad = 0.0;
   std::size_t certificateCells = 0;  ///< quadtree cells the certificate examined
   std::string method = "medial-axis";  ///< "medial-axis", "plane" or "curve"
   GaussMap gaussMap;

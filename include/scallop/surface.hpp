@@ -18,15 +18,22 @@
 // A valid surface has at least one patch; each patch has degrees 1 <= m, n <=
 // kMaxPatchDegree, (m + 1)(n + 1) finite control points whose largest |coordinate| lies in
 // [kMinPatchScale, kMaxPatchScale] (or is 0, rejected as singular below), and is regular: with
-// scale = the largest |coordinate| of its control points, |r_u x r_v| > tau = 1e-12 scale^2
-// at every (u, v) in [0, 1]^2, so that its unit normal (eq 2) is defined everywhere.
+// scale = the largest |coordinate| of its control points, |q| > tau = 1e-12 scale^2 at every
+// (u, v) in [0, 1]^2, where q is r_u x r_v with the factors of collapsed edges split off
+// (bezier.hpp's normalDirectionPolynomials: a boundary row or column of the net collapsed to
+// one point, an apex as on the Utah teapot's knob and bottom, makes r_u x r_v vanish along
+// that edge, and the unit normal there is the limit q / |q|); so that its unit normal (eq 2)
+// is defined everywhere, by continuity on such edges. A cone's apex (limits that differ from
+// ray to ray) is accepted so too: its normals are those limits. Nets collapsed to a point or a
+// line, and corners or interior points where q vanishes, are rejected.
 // Degree 0 in a direction is rejected: r_u or r_v would vanish identically. (Accepted
 // patches also satisfy |r_u x r_v| > 1e-12 S_u S_v, above the threshold where bezier.hpp's
 // unitNormal throws, so unitNormal never throws on them.)
 //
 // Regularity (checkPatchRegularity) is decided by a breadth-first quadtree on [0, 1]^2,
-// with N = r_u x r_v and f = |N|^2 in tensor Bernstein form (bezier.hpp's
-// normalPolynomials, bidegree (2m-1, 2n-1), and normalLengthSquared, (4m-2, 4n-2)),
+// with N = q (r_u x r_v, collapsed edges factored out) and f = |N|^2 in tensor Bernstein
+// form (bezier.hpp's normalDirectionPolynomials, bidegree at most (2m-1, 2n-1), and f,
+// at most (4m-2, 4n-2)),
 // subdivided at cell midpoints by de Casteljau. For each cell:
 //   1. proof, f: every Bernstein coefficient of f on the cell exceeds tau^2 + slack_f:
 //      f is a convex combination of its coefficients, so |N| > tau on the cell;
