@@ -100,6 +100,24 @@ void printSummary(const std::string& source, const OptimalSlicing& result, bool 
   for (const OutputFile& output : outputs) {
     written += (written.empty() ? "" : ", ") + output.path;
   }
+  if (result.method == "covered") {
+    fmt::print(stderr,
+               "scallop: {}: no slicing direction exists: the surface's normals cover the whole "
+               "sphere (proven, {} caps), alpha* = 0; {:.3f} s -> {}\n",
+               source, result.coverage.caps, result.seconds, written);
+    return;
+  }
+  if (result.method == "lattice") {
+    fmt::print(stderr,
+               "scallop: {}: the Gauss map leaves no direction free within its tolerance, but no "
+               "proof covers every direction (none found near ({:.4f}, {:.4f}, {:.4f})); best "
+               "direction found N = ({:.6f}, {:.6f}, {:.6f}), alpha = {:.4f} deg, {}; {:.3f} s -> {}\n",
+               source, result.coverage.unprovenDirection.x, result.coverage.unprovenDirection.y,
+               result.coverage.unprovenDirection.z, result.normal.x, result.normal.y,
+               result.normal.z, toDegrees(result.alphaRad), certificateSummary(result, certify),
+               result.seconds, written);
+    return;
+  }
   fmt::print(stderr,
              "scallop: {}: N* = ({:.6f}, {:.6f}, {:.6f}), alpha* = {:.4f} deg, {}, {} boundary "
              "segments, {:.3f} s -> {}\n",

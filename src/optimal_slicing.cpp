@@ -1411,11 +1411,26 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
     result.normal = bestDirectionForCurve(normals);
     result.alphaRad = minimumAngle(normals, result.normal);
     result.sphereCircle = {result.normal, result.alphaRad};
+  } else if (PlanarDomain domain{withoutSpikes(map.loops, 1e-2 * tol)}; domain.loops.empty()) {
+    // No complement within the map's tolerance. "No direction exists" only with a proof
+    // that the normals cover the sphere (normal_coverage.hpp); otherwise the best direction
+    // that the lattice's seeds polish to, certified below like any other.
+    result.coverage = proveNormalsCoverSphere(surface);
+    if (result.coverage.proven) {
+      result.method = "covered";
+      result.normal = map.pole;
+      result.alphaRad = 0.0;
+      result.sphereCircle = {result.normal, 0.0};
+      result.certified = true;  // alpha = 0 at every direction: proven by the covering
+      result.certifiedAlphaRad = 0.0;
+      result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      return result;
+    }
+    result.method = "lattice";
+    result.normal = map.pole;
+    result.alphaRad = 0.0;
+    result.sphereCircle = {result.normal, 0.0};
   } else {
-    if (map.loops.empty()) throw Error("the complement of the Gauss map is empty: no slicing direction avoids every surface normal");
-    PlanarDomain domain;
-    domain.loops = withoutSpikes(map.loops, 1e-2 * tol);
-    if (domain.loops.empty()) throw Error("the complement of the Gauss map is empty: no slicing direction avoids every surface normal");
     BestCirclesOptions searchOptions;
     // Rival basins: the polygon is within tol of Omega, so a circle within a few tol of the
     // best may be the true optimum's.
@@ -1452,13 +1467,13 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
   // polygonal map stays as the medial-axis result.
   // (A curve-like image was searched on its own exact samples; its |n . N| landscape is flat
   // along the family of normals, where the pattern search only wanders.)
-  if (result.method == "medial-axis") {
+  if (result.method == "medial-axis" || result.method == "lattice") {
     // Every rival is polished: the polygonal map can rank close rival optima wrongly by a
     // few tolerances, and each polish is cheap (a few Newton steps). With the option, then
     // the lattice's seeds (see latticeSeeds); the medial axis's rivals come first and win
     // ties.
     const ContactFinder finder(surface);
-    if (options.latticeSeeds) {
+    if (options.latticeSeeds || result.method == "lattice") {
       for (const Vec3& seed : finder.latticeSeeds(2000, 4, 2.0 * std::numbers::pi / 180.0)) rivals.push_back(seed);
     }
     double bestValue = 2.0;

@@ -93,6 +93,18 @@ Json documentJson(const OptimalSlicing& result, double toleranceDeg) {
   medialAxis["segments"] = result.medialAxisSegments;
   medialAxis["refinements"] = result.medialAxisRefinements;
   document["medial_axis"] = medialAxis;
+  if (result.method == "covered" || result.method == "lattice") {
+    // The covering proof, tried because the complement came out empty.
+    const NormalCoverage& coverage = result.coverage;
+    Json proof;
+    proof["proven"] = coverage.proven;
+    proof["caps"] = coverage.caps;
+    proof["cells"] = coverage.cells;
+    proof["unproven_direction"] = coverage.proven ? Json(nullptr) : vec3Json(coverage.unprovenDirection);
+    document["coverage"] = proof;
+  } else {
+    document["coverage"] = nullptr;
+  }
   document["seconds"] = result.seconds;
   return document;
 }

@@ -115,7 +115,7 @@ TEST(OrientJson, EveryKeyInOrderAndEveryNumberBitForBit) {
                         "normal", "alpha_deg", "certified", "certified_alpha_deg",
                         "certificate_cells", "refuted_alpha_deg", "method", "circle",
                         "sphere_circle", "pole",
-                        "tolerance_deg", "gauss_map", "medial_axis", "seconds"}));
+                        "tolerance_deg", "gauss_map", "medial_axis", "coverage", "seconds"}));
     std::vector<std::string> medialKeys;
     for (const auto& item : ordered.at("medial_axis").items()) medialKeys.push_back(item.key());
     EXPECT_EQ(medialKeys, (std::vector<std::string>{"edges", "rebuilds", "segments", "refinements"}));

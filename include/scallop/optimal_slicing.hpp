@@ -65,6 +65,10 @@
 //         axis's edges rated by their bound alone), where the full-resolution medial axis
 //         takes 4-5 s (Boost's Voronoi falls back to its multiprecision predicates on the
 //         finely sampled, nearly collinear boundary).
+// No complement: when the Gauss map's complement is empty within its tolerance, "no
+//         direction exists" is said only with a proof (normal_coverage.hpp: the normals cover
+//         the sphere; method "covered", alpha* = 0). Without one, the polish runs from the
+//         lattice's seeds and the certificate proves what it can (method "lattice").
 // Degenerate surfaces: a plane (Omega two points) gives alpha* = 90 degrees with N* any
 //         direction orthogonal to the normal (one is returned, `method` "plane"); a surface
 //         whose normals the Gauss map takes for a point (within the tolerance, or too close
@@ -81,6 +85,7 @@
 
 #include "scallop/gauss_map.hpp"
 #include "scallop/medial_axis.hpp"
+#include "scallop/normal_coverage.hpp"
 #include "scallop/stereographic.hpp"
 #include "scallop/surface.hpp"
 #include "scallop/vector.hpp"
@@ -118,7 +123,13 @@ struct OptimalSlicing {
   /// at N* (by bisection), so an uncertified angle is never the answer. 0 otherwise.
   double uncertifiedAlphaRad = 0.0;
   std::size_t certificateCells = 0;  ///< quadtree cells the certificate examined
-  std::string method = "medial-axis";  ///< "medial-axis", "plane" or "curve"
+  /// "medial-axis"; "plane" or "curve" (degenerate maps); "covered": the Gauss map has no
+  /// complement and a proof that the normals cover the sphere says alpha* = 0 exactly (any
+  /// direction; `coverage`); "lattice": no complement within the map's tolerance but no such
+  /// proof either: N* is the best direction the lattice's seeds polish to, its alpha
+  /// certified like any other (an honest lower bound, possibly 0).
+  std::string method = "medial-axis";
+  NormalCoverage coverage;  ///< the covering proof, tried when the complement is empty
   GaussMap gaussMap;
   /// The interior medial axis of the projected complement (pole frame), each edge sampled
   /// as a polyline, for figures. Coarse to fine, that of the final mixed domain: the full
