@@ -1,5 +1,6 @@
 #include "examples.hpp"
 #include "input_file.hpp"
+#include "teapot.hpp"
 #include "scallop/surface.hpp"
 
 #include <algorithm>
@@ -540,9 +541,26 @@ Surface paper2() {
   return {Units::inch, {gridBicubic(z)}};
 }
 
+// The Utah teapot's patches first to last - 1 (teapot.hpp), built like the paper's surfaces:
+// not validated (the knob and the bottom have apexes).
+template <std::size_t first, std::size_t last>
+Surface teapot() {
+  static_assert(first < last && last <= detail::kTeapotPatchCount);
+  Surface surface{Units::inch, {}};
+  for (std::size_t i = first; i < last; ++i) surface.patches.push_back(detail::teapotPatch(i));
+  return surface;
+}
+
 constexpr detail::Example<Surface> kExamples[] = {
     {"paper-1", paper1},
     {"paper-2", paper2},
+    {"teapot", teapot<0, 32>},
+    {"teapot-rim", teapot<0, 4>},
+    {"teapot-body", teapot<4, 12>},
+    {"teapot-handle", teapot<12, 16>},
+    {"teapot-spout", teapot<16, 20>},
+    {"teapot-lid", teapot<20, 28>},
+    {"teapot-bottom", teapot<28, 32>},
 };
 
 }  // namespace
