@@ -98,12 +98,24 @@ constexpr double kMaxPatchScale = 1e20;
 constexpr int kRegularityMaxDepth = 16;
 constexpr std::size_t kRegularityMaxCells = 20000;
 
+/// What the parsers check beyond the text itself.
+enum class SurfaceCheck {
+  full,      ///< validateSurface: the whole contract above, regularity included (the default)
+  formOnly,  ///< only what the text must satisfy: degrees in [1, kMaxPatchDegree], the number
+             ///< of control points, finite coordinates. For patches selected before they are
+             ///< validated (the CLI's --patches) and for reading data whose regularity is
+             ///< judged elsewhere (tests of the built-in examples' files).
+};
+
 /// Parses and validates a surface from JSON text; `sourceName` (a file name, or "-" for
 /// standard input) is used in error messages.
-Surface parseSurface(std::string_view json, const std::string& sourceName);
+Surface parseSurface(std::string_view json, const std::string& sourceName,
+                     SurfaceCheck check = SurfaceCheck::full);
 
-/// Reads, parses and validates a surface file ("-" reads standard input).
-Surface readSurface(const std::string& path);
+/// Reads, parses and validates a surface file ("-" reads standard input): .bpt text
+/// (surface_io.hpp, in inches) when the name ends in ".bpt", JSON when it ends in ".json",
+/// otherwise JSON if the text's first non-blank character is '{' and .bpt if not.
+Surface readSurface(const std::string& path, SurfaceCheck check = SurfaceCheck::full);
 
 /// The surface as JSON in the file format, one row of control points per line. Numbers are
 /// written shortest-round-trip (-0 as -0.0), so parseSurface(surfaceToJson(s)) reproduces
