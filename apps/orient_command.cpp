@@ -41,7 +41,7 @@ constexpr const char* kSphereFigure = "gauss-map.svg";
 constexpr const char* kPlaneFigure = "stereographic.svg";
 
 struct OrientOptions {
-  SurfaceSource surface;  // SURFACE.json ("-": standard input) or --example NAME
+  SurfaceSource surface;  // SURFACE ("-": standard input) or --example NAME, --patches
   std::string tolerance;  // --tolerance DEG, parsed by parseTolerance
   std::string jsonPath;   // --json OUT
   std::string svgDir;     // --svg-dir DIR
@@ -174,12 +174,13 @@ void addOrientCommand(CLI::App& app) {
       "circle on the sphere) and DIR/stereographic.svg (the stereographic plane with the medial "
       "axis); outputs are written all or nothing.\n"
       "Input: JSON {\"units\": \"in\"|\"mm\", \"patches\": [{\"degree\": [m, n], "
-      "\"control_points\": [[[x, y, z], ... n + 1], ... m + 1 rows]}, ...]}; every patch must "
-      "be regular (r_u x r_v != 0).\n"
+      "\"control_points\": [[[x, y, z], ... n + 1], ... m + 1 rows]}, ...]}, or .bpt text (the "
+      "patch count, then per patch a line 'm n' and (m + 1)(n + 1) lines 'x y z', in inches); "
+      "every patch must be regular (r_u x r_v != 0).\n"
       "Example: scallop orient --example paper-2 --json out.json --svg-dir figs");
 
   addSurfaceSourceOptions(*orient, options->surface,
-                          "surface file (JSON, Bezier patches); - reads standard input",
+                          "surface file (JSON or .bpt, Bezier patches); - reads standard input",
                           "use a built-in example surface instead");
   orient
       ->add_option("--tolerance", options->tolerance,

@@ -123,7 +123,7 @@ void addPlanCommand(CLI::App& app) {
       "scallop height, the contour strategy on the optimal planes N*; writes toolpath.ngc, "
       "report.json, paths.svg, paths-plan.svg, gauss-map.svg and stereographic.svg into "
       "scallop-out/ (or --out DIR), all or nothing.");
-  addSurfaceSourceOptions(*plan, options->surface, "surface file (JSON); - reads standard input",
+  addSurfaceSourceOptions(*plan, options->surface, "surface file (JSON or .bpt); - reads standard input",
                           "a built-in example (default paper-1)");
   addStrategyOption(*plan, options->strategy);
   plan->add_option("--tool-radius", options->toolRadius, "ball radius R (default 0.25 in or 6 mm)")

@@ -1,6 +1,38 @@
 #include "surface_options.hpp"
 
+#include <cstddef>
+#include <string_view>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "scallop/error.hpp"
+#include "scallop/surface_io.hpp"
+
 namespace scallop::cli {
+namespace {
+
+// Validates the patches kept from a file one by one, so that a message names a patch by its
+// index in the file ("patches[20]"), not in the selection.
+void validateSelection(const Surface& selected, const std::vector<std::size_t>& indices,
+                       const std::string& source) {
+  for (std::size_t s = 0; s < indices.size(); ++s) {
+    try {
+      validateSurface(Surface{selected.units, {selected.patches[s]}});
+    } catch (const Error& error) {
+      // validateSurface names the only patch "patches[0]".
+      constexpr std::string_view kOnlyPatch = "patches[0]";
+      const std::string_view message = error.what();
+      const std::string located =
+          message.starts_with(kOnlyPatch)
+              ? fmt::format("patches[{}]{}", indices[s], message.substr(kOnlyPatch.size()))
+              : fmt::format("patches[{}]: {}", indices[s], message);
+      throw Error(fmt::format("{}: {}", source, located));
+    }
+  }
+}
+
+}  // namespace
 
 void addSurfaceSourceOptions(CLI::App& command, SurfaceSource& source, const std::string& fileHelp,
                              const std::string& exampleHelp) {
@@ -9,21 +41,47 @@ void addSurfaceSourceOptions(CLI::App& command, SurfaceSource& source, const std
                              ->check(CLI::IsMember(exampleSurfaceNames()))
                              ->type_name("NAME");
   file->excludes(example);
+  command
+      .add_option("--patches", source.patches,
+                  "keep only these patches of the surface: 0-based indices and ranges, e.g. 4 or "
+                  "4-7,12")
+      ->type_name("LIST");
 }
 
 void requireOneSurfaceSource(const SurfaceSource& source, const std::string& command) {
   if (source.input.empty() == source.example.empty()) {
-    throw CLI::ValidationError(command, "give the surface either as SURFACE.json or as --example NAME");
+    throw CLI::ValidationError(command,
+                               "give the surface either as SURFACE (.json or .bpt) or as --example NAME");
   }
 }
 
 Surface loadSurface(const SurfaceSource& source) {
-  return source.example.empty() ? readSurface(source.input) : exampleSurface(source.example);
+  if (source.patches.empty()) {
+    return source.example.empty() ? readSurface(source.input) : exampleSurface(source.example);
+  }
+  const std::string name = source.example.empty()
+                               ? (source.input == "-" ? std::string("<stdin>") : source.input)
+                               : "example " + source.example;
+  // Examples are built, not read: they are not validated (as without --patches).
+  const Surface whole = source.example.empty() ? readSurface(source.input, SurfaceCheck::formOnly)
+                                               : exampleSurface(source.example);
+  std::vector<std::size_t> indices;
+  try {
+    indices = parsePatchSelection(source.patches, whole.patches.size());
+  } catch (const Error& error) {
+    throw Error(fmt::format("{}: --patches: {}", name, error.what()));
+  }
+  Surface selected = selectPatches(whole, indices);
+  if (source.example.empty()) validateSelection(selected, indices, name);
+  return selected;
 }
 
 std::string sourceName(const SurfaceSource& source) {
-  if (!source.example.empty()) return "example " + source.example;
-  return source.input == "-" ? std::string("<stdin>") : source.input;
+  std::string name = !source.example.empty() ? "example " + source.example
+                     : source.input == "-"   ? std::string("<stdin>")
+                                             : source.input;
+  if (!source.patches.empty()) name += fmt::format(" (patches {})", source.patches);
+  return name;
 }
 
 void addStrategyOption(CLI::App& command, std::string& strategy) {

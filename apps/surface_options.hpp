@@ -1,7 +1,7 @@
 #pragma once
 // Command-line pieces that `orient`, `paths` and `plan` share: where the surface comes from
-// (a JSON file, standard input or a built-in example) and, for the tool-path commands, the
-// strategy and the G-code dialect.
+// (a JSON or .bpt file, standard input or a built-in example, and which of its patches) and,
+// for the tool-path commands, the strategy and the G-code dialect.
 
 #include <string>
 
@@ -12,14 +12,16 @@
 
 namespace scallop::cli {
 
-/// SURFACE (a path, "-" for standard input) or --example NAME; at most one is set.
+/// SURFACE (a path, "-" for standard input) or --example NAME; at most one is set. `patches`,
+/// when not empty, keeps only those patches of the surface (--patches "4-7,12").
 struct SurfaceSource {
   std::string input;
   std::string example;
+  std::string patches;
 };
 
 /// Adds the SURFACE positional and --example NAME (checked against the built-in names,
-/// mutually exclusive) to `command`.
+/// mutually exclusive) and --patches LIST to `command`.
 void addSurfaceSourceOptions(CLI::App& command, SurfaceSource& source, const std::string& fileHelp,
                              const std::string& exampleHelp);
 
@@ -27,11 +29,14 @@ void addSurfaceSourceOptions(CLI::App& command, SurfaceSource& source, const std
 /// is given.
 void requireOneSurfaceSource(const SurfaceSource& source, const std::string& command);
 
-/// The surface: the example if named, else the file (scallop::Error naming the file on bad
-/// input).
+/// The surface: the example if named, else the file (JSON or .bpt; scallop::Error naming the
+/// file on bad input), reduced to the selected patches if any. With a selection, a file is
+/// validated after the selection, so the patches not kept need not be regular; errors name
+/// the patches by their indices in the file.
 Surface loadSurface(const SurfaceSource& source);
 
-/// How messages and reports name the surface: "example NAME", "<stdin>" or the path.
+/// How messages and reports name the surface: "example NAME", "<stdin>" or the path, followed
+/// by " (patches LIST)" when some are selected.
 std::string sourceName(const SurfaceSource& source);
 
 /// --strategy contour|raster and --dialect linuxcnc|grbl, into `strategy` and `dialect`.

@@ -123,7 +123,10 @@ void expectPaperSurface(const Surface& surface, const double (&z)[4][4]) {
 }
 
 TEST(Surface, ExampleNames) {
-  EXPECT_EQ(exampleSurfaceNames(), (std::vector<std::string>{"paper-1", "paper-2"}));
+  EXPECT_EQ(exampleSurfaceNames(),
+            (std::vector<std::string>{"paper-1", "paper-2", "teapot", "teapot-rim", "teapot-body",
+                                      "teapot-handle", "teapot-spout", "teapot-lid",
+                                      "teapot-bottom"}));
   try {
     exampleSurface("paper-3");
     ADD_FAILURE() << "no error for an unknown example";
@@ -148,7 +151,7 @@ TEST(Surface, PaperSurfacesHaveThePrintedControlPoints) {
 }
 
 TEST(Surface, PaperSurfacesAreRegular) {
-  for (const std::string& name : exampleSurfaceNames()) {
+  for (const std::string name : {"paper-1", "paper-2"}) {
     const Surface surface = exampleSurface(name);
     EXPECT_NO_THROW(validateSurface(surface)) << name;
     const PatchRegularity regularity = checkPatchRegularity(surface.patches[0]);
@@ -162,7 +165,8 @@ TEST(Surface, PaperSurfacesAreRegular) {
 }
 
 TEST(Surface, ExampleFilesEqualBuiltIns) {
-  for (const std::string& name : exampleSurfaceNames()) {
+  // The teapot's files: surface_io_test.cpp.
+  for (const std::string name : {"paper-1", "paper-2"}) {
     const std::string path = std::string(SCALLOP_EXAMPLES_DIR) + "/surfaces/" + name + ".json";
     expectSameSurface(readSurface(path), exampleSurface(name));
   }

@@ -105,12 +105,24 @@ constexpr double kMaxPatchScale = 1e20;
 constexpr int kRegularityMaxDepth = 16;
 constexpr std::size_t kRegularityMaxCells = 20000;
 
+/// What the parsers check beyond the text itself.
+enum class SurfaceCheck {
+  full,      ///< validateSurface: the whole contract above, regularity included (the default)
+  formOnly,  ///< only what the text must satisfy: degrees in [1, kMaxPatchDegree], the number
+             ///< of control points, finite coordinates. For patches selected before they are
+             ///< validated (the CLI's --patches) and for reading data whose regularity is
+             ///< judged elsewhere (tests of the built-in examples' files).
+};
+
 /// Parses and validates a surface from JSON text; `sourceName` (a file name, or "-" for
 /// standard input) is used in error messages.
-Surface parseSurface(std::string_view json, const std::string& sourceName);
+Surface parseSurface(std::string_view json, const std::string& sourceName,
+                     SurfaceCheck check = SurfaceCheck::full);
 
-/// Reads, parses and validates a surface file ("-" reads standard input).
-Surface readSurface(const std::string& path);
+/// Reads, parses and validates a surface file ("-" reads standard input): .bpt text
+/// (surface_io.hpp, in inches) when the name ends in ".bpt", JSON when it ends in ".json",
+/// otherwise JSON if the text's first non-blank character is '{' and .bpt if not.
+Surface readSurface(const std::string& path, SurfaceCheck check = SurfaceCheck::full);
 
 /// The surface as JSON in the file format, one row of control points per line. Numbers are
 /// written shortest-round-trip (-0 as -0.0), so parseSurface(surfaceToJson(s)) reproduces
@@ -147,13 +159,24 @@ PatchRegularity checkPatchRegularity(const BezierPatch& patch);
 double surfaceScale(const Surface& surface);
 
 /// Names of the built-in example surfaces, and one of them by name (throws on an unknown
-/// name). Both are the bicubic test surfaces of the paper's Section 4, in inches, on a
+/// name). All are in inches. The bicubic test surfaces of the paper's Section 4, on a
 /// 3 x 3 inch footprint with p_jk = (k, j, z_jk):
 ///   "paper-1"  test surface #1 (Section 4.1, Fig. 1); the paper's optimum
 ///              N* = (0.248, -0.969, 0.001), eq (18);
 ///   "paper-2"  test surface #2 (Section 4.2, Fig. 8), symmetric under p_jk <-> p_kj;
 ///              N* = (0.975, -0.221, -0.002), eq (19).
-/// The same surfaces are in examples/surfaces/<name>.json.
+/// The Utah teapot (Newell 1975; POV-Ray 3.7's teapot.inc, see the README), 32 bicubic
+/// patches in the standard order, z up, 3.15 in tall, and its natural parts (patch indices of
+/// "teapot"):
+///   "teapot"          all 32 patches;
+///   "teapot-rim"      0-3;    "teapot-body"    4-11 (upper 4-7, lower 8-11);
+///   "teapot-handle"   12-15;  "teapot-spout"   16-19;
+///   "teapot-lid"      20-27 (knob 20-23, lid 24-27);  "teapot-bottom"  28-31.
+/// The knob's patches 20-23 and the bottom's 28-31 have their row p_0k collapsed to one point
+/// (the apex on the axis), where r_v = 0: they are not regular in the sense of the contract
+/// above, and exampleSurface does not validate.
+/// The same surfaces are in examples/surfaces/<name>.json (paper-1, paper-2, teapot; also
+/// teapot.bpt), each part being a range of teapot.json's patches.
 std::vector<std::string> exampleSurfaceNames();
 Surface exampleSurface(const std::string& name);
 
