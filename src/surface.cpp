@@ -549,8 +549,8 @@ Surface paper2() {
   return {Units::inch, {gridBicubic(z)}};
 }
 
-// The Utah teapot's patches first to last - 1 (teapot.hpp), built like the paper's surfaces:
-// not validated (the knob and the bottom have apexes).
+// The Utah teapot's patches first to last - 1 (teapot.hpp), built like the paper's surfaces
+// (valid: the knob's and the bottom's apexes have their normals' limits; tested).
 template <std::size_t first, std::size_t last>
 Surface teapot() {
   static_assert(first < last && last <= detail::kTeapotPatchCount);

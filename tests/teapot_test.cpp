@@ -1,0 +1,183 @@
+// Optimal slicing on the Utah teapot (examples/surfaces/teapot.json: Newell's 32 bicubic
+// patches, from POV-Ray's sample teapot.inc), the paper's method alone (no lattice seeds),
+// against an independent brute force on dense normals: every single patch, the natural groups
+// and the whole. Surfaces of revolution, parabolic lines along patch edges and across the
+// interior along iso-lines, and collapsed edges (the knob's and the bottom's apexes) all
+// appear here.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <utility>
+#include <chrono>
+#include <cstdio>
+#include <cmath>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "gauss_references.hpp"
+#include "scallop/optimal_slicing.hpp"
+#include "scallop/surface.hpp"
+
+namespace scallop {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+// The example file, read and validated as a user's file would be (the built-in example is
+// the same data, bit for bit: surface_io_test.cpp).
+Surface teapot() { return readSurface(std::string(SCALLOP_EXAMPLES_DIR) + "/surfaces/teapot.json"); }
+
+Surface patchesOf(const Surface& whole, int first, int last) {
+  Surface s;
+  s.units = whole.units;
+  for (int i = first; i <= last; ++i) s.patches.push_back(whole.patches[static_cast<std::size_t>(i)]);
+  return s;
+}
+
+struct Case {
+  std::string name;
+  int first, last;
+};
+
+// Every single patch and the groups whose complement is not empty: orient matches the brute
+// force within 0.01 degree, is certified, and never claims more than the samples allow.
+TEST(Teapot, OrientMatchesBruteForceOnEveryPatchAndOpenGroup) {
+  const Surface whole = teapot();
+  ASSERT_EQ(whole.patches.size(), 32u);
+  std::vector<Case> cases;
+  // Patches 18 and 19 (the spout's lip) are left to SpoutLipAgainstDenseSamples: their
+  // normals turn through nearly every direction within a hair of parameter, so 129 x 129
+  // samples miss them and the brute force claims some 3.8 degrees where the truth is 0.19.
+  for (int i = 0; i < 32; ++i) {
+    if (i != 18 && i != 19) cases.push_back({"patch " + std::to_string(i), i, i});
+  }
+  cases.push_back({"body", 4, 11});
+  cases.push_back({"handle", 12, 15});
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    const Surface s = patchesOf(whole, c.first, c.last);
+    OptimalSlicingOptions options;  // lattice seeds off: the paper's method alone
+    ASSERT_FALSE(options.latticeSeeds);
+    const auto start = std::chrono::steady_clock::now();
+    const OptimalSlicing result = optimalSlicing(s, options);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const reference::BruteForceSlicing bruteForce = reference::bruteForceOptimalAlpha(s);
+    EXPECT_EQ(result.method, "medial-axis");
+    EXPECT_TRUE(result.certified);
+    EXPECT_NEAR(result.alphaRad, bruteForce.alphaRad, 0.01 * kDeg)
+        << "brute force at (" << bruteForce.direction.x << ", " << bruteForce.direction.y << ", "
+        << bruteForce.direction.z << ")";
+    // The certified angle at N* can be no larger than the samples' angle there.
+    const std::vector<Vec3> dense = reference::sampleRegularNormals(s, 160);
+    EXPECT_LE(result.certifiedAlphaRad, reference::sampledAlpha(dense, result.normal) + 1e-12);
+    std::printf("[          ] %s: alpha* %.4f deg (brute force %.4f), %.3f s\n", c.name.c_str(),
+                result.alphaRad / kDeg, bruteForce.alphaRad / kDeg, seconds);
+  }
+}
+
+// With the lattice's seeds as a safety net, no answer changes.
+TEST(Teapot, LatticeSeedsChangeNoAnswer) {
+  const Surface whole = teapot();
+  for (int i = 0; i < 32; i += 3) {
+    SCOPED_TRACE("patch " + std::to_string(i));
+    const Surface s = patchesOf(whole, i, i);
+    OptimalSlicingOptions without;
+    OptimalSlicingOptions with;
+    with.latticeSeeds = true;
+    const OptimalSlicing a = optimalSlicing(s, without);
+    const OptimalSlicing b = optimalSlicing(s, with);
+    EXPECT_NEAR(a.alphaRad, b.alphaRad, 1e-9);
+  }
+}
+
+// The closed groups (rim, spout, lid, bottom, the whole teapot): the Gauss map leaves no
+// direction free. "No direction exists" needs a proof; where the covering proof does not get
+// through the seams of these surfaces of revolution, the answer is the best direction found,
+// certified, never more than the samples allow.
+TEST(Teapot, ClosedGroupsClaimNothingUnproven) {
+  const Surface whole = teapot();
+  for (const Case& c : {Case{"rim", 0, 3}, Case{"spout", 16, 19}, Case{"lid", 20, 27},
+                        Case{"bottom", 28, 31}, Case{"whole", 0, 31}}) {
+    SCOPED_TRACE(c.name);
+    const Surface s = patchesOf(whole, c.first, c.last);
+    const OptimalSlicing result = optimalSlicing(s);
+    ASSERT_TRUE(result.method == "covered" || result.method == "lattice") << result.method;
+    EXPECT_EQ(result.coverage.proven, result.method == "covered");
+    EXPECT_TRUE(result.certified);
+    // The certified angle at N* can be no larger than the samples' angle there.
+    const std::vector<Vec3> dense = reference::sampleRegularNormals(s, 160);
+    EXPECT_LE(result.certifiedAlphaRad, reference::sampledAlpha(dense, result.normal) + 1e-12);
+  }
+}
+
+// Every sampled normal of every patch lies in the computed Gauss map (or within its
+// tolerance of its boundary): a map that loses normals is a bug.
+TEST(Teapot, SampledNormalsLieInTheGaussMap) {
+  const Surface whole = teapot();
+  for (int i = 0; i < 32; ++i) {
+    SCOPED_TRACE("patch " + std::to_string(i));
+    const Surface s = patchesOf(whole, i, i);
+    const OptimalSlicing result = optimalSlicing(s);
+    // alpha* is the radius of an empty cap around N*: no sampled normal inside it.
+    const std::vector<Vec3> dense = reference::sampleRegularNormals(s, 100);
+    ASSERT_TRUE(result.certified);
+    EXPECT_GE(reference::sampledAlpha(dense, result.normal), result.certifiedAlphaRad - 1e-12);
+  }
+}
+
+}  // namespace
+}  // namespace scallop
+
+namespace scallop {
+namespace {
+
+// The spout's lip (patches 18 and 19): the polish's first angle there was refuted by the
+// certificate (a nearer normal it had not seen), so alpha* is what the certificate proves at
+// N*, by bisection. The nearest normal to N* on the patch, found by dense samples refined by
+// a local search, is within 1e-4 degree above it (never below), and the brute force's best
+// direction (on its own coarser samples) is no better when measured on 1601 x 1601 samples.
+TEST(Teapot, SpoutLipAgainstDenseSamples) {
+  const Surface whole = teapot();
+  for (int i : {18, 19}) {
+    SCOPED_TRACE("patch " + std::to_string(i));
+    const Surface s = patchesOf(whole, i, i);
+    const OptimalSlicing result = optimalSlicing(s);
+    ASSERT_TRUE(result.certified);
+    const std::vector<Vec3> dense = reference::sampleRegularNormals(s, 1600);
+    const double atOptimum = reference::sampledAlpha(dense, result.normal);
+    EXPECT_GE(atOptimum, result.alphaRad - 1e-12);
+    // The nearest normal to +-N* on the continuous patch: the best sample refined by a
+    // shrinking pattern search in (u, v) (an upper estimate still, but to ~1e-10 rad).
+    const BezierPatch& patch = s.patches.front();
+    auto angleAt = [&](double u, double v) {
+      const double c = std::abs(dot(unitNormal(patch, u, v), result.normal));
+      return std::acos(std::min(1.0, c));
+    };
+    double bestU = 0.0, bestV = 0.0, best = 10.0;
+    for (int a = 0; a <= 400; ++a) {
+      for (int b = 0; b <= 400; ++b) {
+        const double value = angleAt(a / 400.0, b / 400.0);
+        if (value < best) best = value, bestU = a / 400.0, bestV = b / 400.0;
+      }
+    }
+    for (double step = 1.0 / 400.0; step > 1e-13;) {
+      bool improved = false;
+      for (const auto& [du, dv] : {std::pair{1, 0}, std::pair{-1, 0}, std::pair{0, 1}, std::pair{0, -1},
+                                   std::pair{1, 1}, std::pair{1, -1}, std::pair{-1, 1}, std::pair{-1, -1}}) {
+        const double u = std::clamp(bestU + du * step, 0.0, 1.0), v = std::clamp(bestV + dv * step, 0.0, 1.0);
+        const double value = angleAt(u, v);
+        if (value < best) best = value, bestU = u, bestV = v, improved = true;
+      }
+      if (!improved) step *= 0.5;
+    }
+    EXPECT_GE(best, result.alphaRad - 1e-12);
+    EXPECT_LE(best, result.alphaRad + 1e-4 * kDeg) << "at (u, v) = (" << bestU << ", " << bestV << ")";
+    const reference::BruteForceSlicing bruteForce = reference::bruteForceOptimalAlpha(s);
+    EXPECT_LE(reference::sampledAlpha(dense, bruteForce.direction), result.alphaRad + 0.01 * kDeg);
+  }
+}
+
+}  // namespace
+}  // namespace scallop
