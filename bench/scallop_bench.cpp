@@ -119,6 +119,45 @@ void BM_Orient(benchmark::State& state, const char* name) {
   }
 }
 
+// The same with the lattice's 2,000 seeds (OptimalSlicingOptions::latticeSeeds), as before
+// they became an option: what the safety net costs.
+void BM_OrientWithLatticeSeeds(benchmark::State& state, const char* name) {
+  const scallop::Surface surface = scallop::exampleSurface(name);
+  scallop::OptimalSlicingOptions options;
+  options.latticeSeeds = true;
+  for (auto _ : state) {
+    scallop::OptimalSlicing result = scallop::optimalSlicing(surface, options);
+    benchmark::DoNotOptimize(result.alphaRad);
+  }
+}
+
+// The Utah teapot at the default tolerance (issue targets: each patch <= 50 ms, the whole
+// <= 1 s): BM_OrientTeapotPatch/<i> one patch, BM_OrientTeapot/<part> a built-in part or the
+// whole (the closed parts end in the covering proof, or the lattice's polish without one).
+void BM_OrientTeapotPatch(benchmark::State& state) {
+  const scallop::Surface whole = scallop::exampleSurface("teapot");
+  scallop::Surface surface{whole.units, {whole.patches[static_cast<std::size_t>(state.range(0))]}};
+  scallop::OptimalSlicing result;
+  for (auto _ : state) {
+    result = scallop::optimalSlicing(surface);
+    double alpha = result.alphaRad;  // a copy: see BM_OrientFine
+    benchmark::DoNotOptimize(alpha);
+  }
+  state.counters["alpha_deg"] = result.alphaRad / kDegree;
+}
+
+void BM_OrientTeapot(benchmark::State& state, const char* name) {
+  const scallop::Surface surface = scallop::exampleSurface(name);
+  scallop::OptimalSlicing result;
+  for (auto _ : state) {
+    result = scallop::optimalSlicing(surface);
+    double alpha = result.alphaRad;  // a copy: see BM_OrientFine
+    benchmark::DoNotOptimize(alpha);
+  }
+  state.counters["alpha_deg"] = result.alphaRad / kDegree;
+  state.counters["covered"] = result.method == "covered" ? 1.0 : 0.0;
+}
+
 void BM_OrientFine(benchmark::State& state, const char* name, double toleranceDeg) {
   const scallop::Surface surface = scallop::exampleSurface(name);
   scallop::OptimalSlicingOptions options;
@@ -240,6 +279,16 @@ void BM_MedialAxis(benchmark::State& state) {
 
 BENCHMARK_CAPTURE(BM_Orient, paper1, "paper-1")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Orient, paper2, "paper-2")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_OrientWithLatticeSeeds, paper1, "paper-1")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_OrientWithLatticeSeeds, paper2, "paper-2")->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_OrientTeapotPatch)->DenseRange(0, 31)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_OrientTeapot, rim, "teapot-rim")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_OrientTeapot, body, "teapot-body")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_OrientTeapot, handle, "teapot-handle")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_OrientTeapot, spout, "teapot-spout")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_OrientTeapot, lid, "teapot-lid")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_OrientTeapot, bottom, "teapot-bottom")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_OrientTeapot, whole, "teapot")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_GaussMap, paper1, "paper-1", 0.5)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_GaussMap, paper2, "paper-2", 0.5)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_OrientMedialAxis, paper1, "paper-1", 0.5)->Unit(benchmark::kMillisecond);
