@@ -49,6 +49,19 @@ void runContour(const Surface& surface, const JobOptions& options, JobResult& re
     if (normal.z < 0.0) normal = -normal;
     alpha = result.orientation->certified ? result.orientation->certifiedAlphaRad
                                           : minimumAngleBound(surface, normal);
+    // A closed surface (the teapot) has no direction free of its normals: every plane
+    // orientation touches it tangentially, so no spacing bounds the scallop height.
+    const std::string& method = result.orientation->method;
+    if (!options.spacing && (method == "covered" || method == "lattice") && !(alpha > 0.0)) {
+      throw Error(method == "covered"
+                      ? "no slicing direction exists: the surface's normals cover the whole "
+                        "sphere (proven), so every contour plane touches it tangentially and no "
+                        "spacing bounds the scallop height; use --strategy raster, or give "
+                        "--spacing"
+                      : "no slicing direction free of the surface's normals was found (the "
+                        "Gauss map covers the sphere within its tolerance): no spacing bounds "
+                        "the scallop height; use --strategy raster, or give --spacing");
+    }
   }
   ContourOptions contour;
   contour.normal = normal;
