@@ -579,6 +579,14 @@ constexpr detail::Example<Surface> kExamples[] = {
 
 std::string_view unitsName(Units units) { return units == Units::inch ? "in" : "mm"; }
 
+void validateSurface(const Surface& surface, const std::string& sourceName) {
+  try {
+    validateSurface(surface);
+  } catch (const Error& error) {
+    throw Error(fmt::format("{}: {}", sourceName, error.what()));
+  }
+}
+
 void validateSurface(const Surface& surface) {
   if (surface.patches.empty()) throw Error("patches: no patches; a surface needs at least one");
   for (std::size_t i = 0; i < surface.patches.size(); ++i) validatePatch(surface.patches[i], i);
@@ -600,12 +608,7 @@ Surface parseSurface(std::string_view json, const std::string& sourceName, Surfa
     throw Error(fmt::format("{}: malformed JSON: {}", source, withoutExceptionId(error.what())));
   }
   Surface surface = parseDocument(document, source);
-  if (check == SurfaceCheck::formOnly) return surface;
-  try {
-    validateSurface(surface);
-  } catch (const Error& error) {
-    throw Error(fmt::format("{}: {}", source, error.what()));
-  }
+  if (check == SurfaceCheck::full) validateSurface(surface, source);
   return surface;
 }
 

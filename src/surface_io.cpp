@@ -255,12 +255,7 @@ Surface parseBptSurface(std::string_view text, const std::string& sourceName, Su
   }
   BptParser parser{source, LineReader(text), 0, {}};
   Surface surface = parser.read();
-  if (check == SurfaceCheck::formOnly) return surface;
-  try {
-    validateSurface(surface);
-  } catch (const Error& error) {
-    throw Error(fmt::format("{}: {}", source, error.what()));
-  }
+  if (check == SurfaceCheck::full) validateSurface(surface, source);
   return surface;
 }
 

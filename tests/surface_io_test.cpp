@@ -20,6 +20,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_fixture.hpp"
+#include "message_checks.hpp"
 #include "scallop/error.hpp"
 #include "scallop/surface.hpp"
 #include "scallop/surface_io.hpp"
@@ -75,14 +76,7 @@ std::string bptError(const std::string& text, SurfaceCheck check = SurfaceCheck:
   return "";
 }
 
-void expectMessageContains(const std::string& message, const std::vector<std::string>& parts,
-                           const std::string& context) {
-  ASSERT_FALSE(message.empty()) << "accepted: " << context;
-  for (const std::string& part : parts) {
-    EXPECT_NE(message.find(part), std::string::npos)
-        << "message '" << message << "' lacks '" << part << "' for: " << context;
-  }
-}
+using test::expectMessageContains;
 
 // A graph patch of degrees (m, n) over a jittered grid, random heights: regular.
 BezierPatch randomPatch(std::mt19937_64& rng, int m, int n) {

@@ -17,6 +17,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "message_checks.hpp"
 #include "scallop/bernstein.hpp"
 #include "scallop/bezier.hpp"
 #include "scallop/error.hpp"
@@ -61,14 +62,7 @@ std::string parseError(const std::string& content, const std::string& source = "
   return "";
 }
 
-void expectMessageContains(const std::string& message, const std::vector<std::string>& parts,
-                           const std::string& context) {
-  ASSERT_FALSE(message.empty()) << "accepted: " << context;
-  for (const std::string& part : parts) {
-    EXPECT_NE(message.find(part), std::string::npos)
-        << "message '" << message << "' lacks '" << part << "' for: " << context;
-  }
-}
+using test::expectMessageContains;
 
 // p_jk of a patch with the given degrees, from a function of (j, k).
 BezierPatch makePatch(int m, int n, const std::function<Vec3(int, int)>& point) {

@@ -133,6 +133,8 @@ std::string surfaceToJson(const Surface& surface);
 
 /// Throws scallop::Error ("patches[i]...: ...") unless `surface` satisfies the contract.
 void validateSurface(const Surface& surface);
+/// The same, the message prefixed with `sourceName` ("s.json: patches[i]...: ...").
+void validateSurface(const Surface& surface, const std::string& sourceName);
 
 enum class RegularityVerdict {
   regular,    ///< |r_u x r_v| > tau proven on all of [0, 1]^2
