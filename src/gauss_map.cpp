@@ -1298,10 +1298,10 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
   // when the complement comes out empty.
   if (poleBuilder < builders.size()) {
     const Cell& c = builders[poleBuilder].cells[poleIndex];
-    const double kPoleOffsetU = options.offsetPole ? 0.4142135623730950 : 0.5;  // sqrt(2) - 1
-    const double kPoleOffsetV = options.offsetPole ? 0.5811388300841898 : 0.5;  // sqrt(10)/2 - 1
-    map.pole = unitNormal(*builders[poleBuilder].data.patch, c.u0 + kPoleOffsetU * (c.u1 - c.u0),
-                          c.v0 + kPoleOffsetV * (c.v1 - c.v0));
+    const double poleOffsetU = options.offsetPole ? 0.4142135623730950 : 0.5;  // sqrt(2) - 1
+    const double poleOffsetV = options.offsetPole ? 0.5811388300841898 : 0.5;  // sqrt(10)/2 - 1
+    map.pole = unitNormal(*builders[poleBuilder].data.patch, c.u0 + poleOffsetU * (c.u1 - c.u0),
+                          c.v0 + poleOffsetV * (c.v1 - c.v0));
   } else {
     map.pole = first;
   }
