@@ -1282,12 +1282,25 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
   const Vec3 first = unitNormal(surface.patches.front(), 0.5, 0.5);
   std::size_t poleBuilder = builders.size(), poleIndex = 0;
   double poleArea = 0.0;
-  for (std::size_t b = 0; b < builders.size(); ++b) {
-    const std::vector<Cell>& list = builders[b].cells;
-    for (std::size_t i = 0; i < list.size(); ++i) {
-      const double area = (list[i].u1 - list[i].u0) * (list[i].v1 - list[i].v0);
-      if (!list[i].fold && area > poleArea) poleBuilder = b, poleIndex = i, poleArea = area;
+  // Without a regular cell (a patch whose normals vary little, crossed by one parabolic
+  // line, is a single traced cell), the largest traced cell is split instead of traced, a
+  // bounded number of times (each split quarters a cell).
+  for (int split = 0; split <= 8 && poleBuilder == builders.size(); ++split) {
+    std::size_t tracedBuilder = builders.size(), tracedIndex = 0;
+    double tracedArea = 0.0;
+    for (std::size_t b = 0; b < builders.size(); ++b) {
+      const std::vector<Cell>& list = builders[b].cells;
+      for (std::size_t i = 0; i < list.size(); ++i) {
+        const double area = (list[i].u1 - list[i].u0) * (list[i].v1 - list[i].v0);
+        if (!list[i].fold && area > poleArea) poleBuilder = b, poleIndex = i, poleArea = area;
+        if (list[i].traceAxis != 0 && area > tracedArea) tracedBuilder = b, tracedIndex = i, tracedArea = area;
+      }
     }
+    if (poleBuilder < builders.size() || tracedBuilder == builders.size()) break;
+    CellBuilder& builder = builders[tracedBuilder];
+    builder.noTrace.insert(CellBuilder::boundsOf(builder.cells[tracedIndex]));
+    builder.cells.clear();
+    inPatch(builder.data, [&] { builder.run(); });
   }
   // The pole is the cell's centre normal, or with options.offsetPole the normal at a point
   // with irrational-looking offsets: a dyadic centre's normal can be exactly the normal at a
