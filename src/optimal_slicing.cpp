@@ -13,6 +13,7 @@
 #include <limits>
 #include <numbers>
 #include <numeric>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -1381,12 +1382,34 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
   OptimalSlicing result;
   GaussMapOptions gaussOptions;
   gaussOptions.toleranceRad = tol;
-  result.gaussMap = symmetrizedGaussMap(surface, gaussOptions);
-  if (result.gaussMap.kind == GaussMapKind::region && result.gaussMap.loops.empty()) {
-    // An empty complement may be the pole lying on a cell edge's image (see gauss_map.hpp,
-    // Pole): once more with the pole off its cell's centre.
-    gaussOptions.offsetPole = true;
+  BestCirclesOptions searchOptions;
+  // Rival basins: the polygon is within tol of Omega, so a circle within a few tol of the
+  // best may be the true optimum's.
+  searchOptions.windowRad = 4.0 * tol;
+  searchOptions.coarseToFine = options.coarseToFine;
+  // The map and its medial axis, and once more with the pole off its cell's centre when the
+  // complement comes out empty (the pole on a cell edge's image, see gauss_map.hpp, Pole)
+  // or the medial axis refuses it (loops that touch on its integer grid, a Voronoi diagram
+  // that fails validation in every rotation): another pole projects another plane.
+  // Each map's loops go to the medial axis as they are (Clipper's output is simple), and
+  // only if it refuses them without their zero-width zigzags (withoutSpikes: removing a
+  // vertex can make its chord cross a slit's other side, as on nearly developable patches).
+  std::optional<BestCircles> found;
+  for (int attempt = 0; attempt < 2 && !found; ++attempt) {
+    gaussOptions.offsetPole = attempt == 1;
     result.gaussMap = symmetrizedGaussMap(surface, gaussOptions);
+    if (result.gaussMap.kind != GaussMapKind::region) break;
+    PlanarDomain domain{result.gaussMap.loops};
+    if (domain.loops.empty()) continue;
+    for (int cleaned = 0; cleaned < 2 && !found; ++cleaned) {
+      if (cleaned == 1) domain.loops = withoutSpikes(result.gaussMap.loops, 1e-2 * tol);
+      if (domain.loops.empty()) break;
+      try {
+        found = bestCircles(domain, searchOptions);
+      } catch (const Error&) {
+        if (attempt == 1 && cleaned == 1) throw;
+      }
+    }
   }
   const GaussMap& map = result.gaussMap;
   result.pole = map.pole;
@@ -1411,7 +1434,7 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
     result.normal = bestDirectionForCurve(normals);
     result.alphaRad = minimumAngle(normals, result.normal);
     result.sphereCircle = {result.normal, result.alphaRad};
-  } else if (PlanarDomain domain{withoutSpikes(map.loops, 1e-2 * tol)}; domain.loops.empty()) {
+  } else if (!found) {
     // No complement within the map's tolerance. "No direction exists" only with a proof
     // that the normals cover the sphere (normal_coverage.hpp); otherwise the best direction
     // that the lattice's seeds polish to, certified below like any other.
@@ -1431,12 +1454,7 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
     result.alphaRad = 0.0;
     result.sphereCircle = {result.normal, 0.0};
   } else {
-    BestCirclesOptions searchOptions;
-    // Rival basins: the polygon is within tol of Omega, so a circle within a few tol of the
-    // best may be the true optimum's.
-    searchOptions.windowRad = 4.0 * tol;
-    searchOptions.coarseToFine = options.coarseToFine;
-    const BestCircles search = bestCircles(domain, searchOptions);
+    const BestCircles& search = *found;
     result.medialAxisEdges = search.axis.edges.size();
     result.medialAxisRebuilds = search.axis.rebuilds;
     result.medialAxisSegments = search.segments;
