@@ -11,6 +11,7 @@
 #include <limits>
 #include <numbers>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -45,14 +46,84 @@ double gamma(int k) {
   return ku / (1.0 - ku);
 }
 
-// The normal polynomials of one patch and what the bounds need.
+// The normal direction polynomials of one patch and what the bounds need.
 struct PatchData {
   const BezierPatch* patch = nullptr;
-  std::array<Bernstein2, 3> n;  // N = r_u x r_v, bidegree (2m - 1, 2n - 1)
-  // Bound on the rounding of one coefficient of N restricted to a rectangle (each
-  // component), from bernstein.hpp's restrictTo bound, times 4.
+  // q: N = r_u x r_v with collapsed edges' factors divided out (normalDirectionPolynomials),
+  // bidegree at most (2m - 1, 2n - 1); q = N on a patch without collapsed edges.
+  std::array<Bernstein2, 3> n;
+  // dq/du, dq/dv, for Newton on patches with collapsed edges (N vanishes on the apex row).
+  std::array<Bernstein2, 3> nu, nv;
+  bool divided = false;
+  // Bound on the rounding of one coefficient of q restricted to a rectangle (each
+  // component), from bernstein.hpp's restrictTo bound, plus the division's, times 4.
   double coefficientError = 0.0;
+  // Per patch edge (0: v = 0, 1: u = 1, 2: v = 1, 3: u = 0): the edge's control points all
+  // equal (an apex row), and q's coefficients on it all parallel (its normal is constant).
+  std::array<bool, 4> collapsed{};
+  std::array<bool, 4> constantEdge{};
 };
+
+// A patch edge glued to another (or to another edge of the same patch): q along the two
+// edges, the second's parameter reversed or not, is parallel (certified), so the unit normals
+// agree up to sign along them.
+struct Glue {
+  std::size_t patch = 0;
+  int edge = 0;
+  bool reversed = false;
+  bool shared = false;  // the edges' control points are equal bit for bit
+};
+
+// A rectangle of an assembly: orientation +-1, and the sides that are glued to another
+// rectangle of the assembly (cancelled in the boundary chain).
+struct Rect {
+  std::size_t patch = 0;
+  double u0 = 0.0, u1 = 1.0, v0 = 0.0, v1 = 1.0;
+  double orientation = 1.0;
+  std::array<bool, 4> glued{};
+  bool same(const Rect& r) const {
+    return patch == r.patch && u0 == r.u0 && u1 == r.u1 && v0 == r.v0 && v1 == r.v1;
+  }
+};
+
+// Rectangle bounds are multiples of this (exact, and 1 - x is exact): glued sides match
+// exactly in parameter.
+constexpr double kGrid = 1.0 / (1 << 20);
+// Largest rectangles in an assembly (a cycle around a vertex has 4 on the teapot).
+constexpr std::size_t kMaxAssembly = 8;
+
+// The coefficients of q on patch edge `edge`, its parameter increasing.
+std::vector<Vec3> edgeRow(const std::array<Bernstein2, 3>& r, int edge) {
+  const int m = r[0].degreeU, n = r[0].degreeV;
+  auto at = [&](int i, int j) {
+    const std::size_t k = static_cast<std::size_t>(i * (n + 1) + j);
+    return Vec3{r[0].coefficients[k], r[1].coefficients[k], r[2].coefficients[k]};
+  };
+  std::vector<Vec3> row;
+  if (edge == 0 || edge == 2) {
+    for (int i = 0; i <= m; ++i) row.push_back(at(i, edge == 0 ? 0 : n));
+  } else {
+    for (int j = 0; j <= n; ++j) row.push_back(at(edge == 3 ? 0 : m, j));
+  }
+  return row;
+}
+
+// The control points of patch edge `edge`, its parameter increasing.
+std::vector<Vec3> edgeControl(const BezierPatch& p, int edge) {
+  std::vector<Vec3> row;
+  if (edge == 0 || edge == 2) {
+    for (int i = 0; i <= p.degreeU; ++i) row.push_back(p.at(i, edge == 0 ? 0 : p.degreeV));
+  } else {
+    for (int j = 0; j <= p.degreeV; ++j) row.push_back(p.at(edge == 3 ? 0 : p.degreeU, j));
+  }
+  return row;
+}
+
+double binomial(int n, int k) {
+  double b = 1.0;
+  for (int i = 1; i <= k; ++i) b = b * (n - k + i) / i;
+  return b;
+}
 
 struct Seed {
   std::size_t patch = 0;
@@ -68,6 +139,7 @@ struct Preimage {
   double sign = 1.0;
   double u = 0.0, v = 0.0;
   double stretch = 0.0;
+  double largestStretch = 0.0;  // the Jacobian's largest singular value
 };
 
 struct Cap {
@@ -123,16 +195,58 @@ class Prover {
     for (const BezierPatch& patch : surface.patches) {
       PatchData data;
       data.patch = &patch;
-      data.n = normalPolynomials(patch);
-      double largest = 0.0;
+      const std::array<Bernstein2, 3> full = normalPolynomials(patch);
+      const NormalDirection direction = normalDirectionPolynomials(patch);
+      data.n = direction.polynomials;
+      data.divided = direction.powers.any();
+      double largestN = 0.0, largestQ = 0.0;
       for (int k = 0; k < 3; ++k) {
-        for (double c : data.n[k].coefficients) largest = std::max(largest, std::abs(c));
+        for (double c : full[k].coefficients) largestN = std::max(largestN, std::abs(c));
+        for (double c : data.n[k].coefficients) largestQ = std::max(largestQ, std::abs(c));
       }
+      // N's coefficients (products of differences) round by gamma_4 of their size; each
+      // division by an edge factor scales the kept coefficients by up to the degree, rounds
+      // once, and drops a row below unitNormal's threshold (bernstein.hpp, bezier.hpp).
+      const int divisions = direction.powers.u0 + direction.powers.u1 + direction.powers.v0 +
+                            direction.powers.v1;
+      double amplification = 1.0;
+      for (int k = 0; k < divisions; ++k) {
+        amplification *= std::max(full[0].degreeU, full[0].degreeV);
+      }
+      const double divisionError =
+          divisions == 0 ? 0.0
+                         : amplification * (gamma(4 + divisions) * largestN +
+                                            normalRoundingThreshold(patch));
       data.coefficientError =
-          4.0 * (gamma(6 * data.n[0].degreeU) + gamma(6 * data.n[0].degreeV) + gamma(4)) *
-          largest;
+          4.0 * ((gamma(6 * data.n[0].degreeU) + gamma(6 * data.n[0].degreeV) + gamma(4)) *
+                     std::max(largestQ, largestN) +
+                 divisionError);
+      if (data.divided) {
+        for (int k = 0; k < 3; ++k) {
+          data.nu[k] = derivativeU(data.n[k]);
+          data.nv[k] = derivativeV(data.n[k]);
+        }
+      }
+      for (int edge = 0; edge < 4; ++edge) {
+        const std::vector<Vec3> points = edgeControl(patch, edge);
+        data.collapsed[edge] = std::all_of(points.begin(), points.end(),
+                                           [&](const Vec3& p) { return p == points[0]; });
+        if (!data.collapsed[edge]) continue;
+        // Constant normal along the apex row: every coefficient of q there parallel to the
+        // first (to within their rounding), so q(t) = lambda(t) a_0 on the edge.
+        const std::vector<Vec3> row = edgeRow(data.n, edge);
+        bool parallel = norm(row[0]) > 0.0;
+        for (const Vec3& a : row) {
+          const double tolerance =
+              2.0 * kSqrt3 * data.coefficientError * (norm(a) + norm(row[0])) +
+              gamma(8) * norm(a) * norm(row[0]);
+          parallel = parallel && norm(cross(a, row[0])) <= tolerance && dot(a, row[0]) > 0.0;
+        }
+        data.constantEdge[edge] = parallel;
+      }
       patches_.push_back(std::move(data));
     }
+    buildGlues();
     for (std::size_t p = 0; p < patches_.size(); ++p) {
       for (int i = 0; i < kSeedGrid; ++i) {
         for (int j = 0; j < kSeedGrid; ++j) {
@@ -247,6 +361,7 @@ class Prover {
     result.cells = cells_;
     result.skippedCells = skipped_;
     result.samples = samples_;
+    result.gluedCaps = glued_;
   }
 
   // Over the rectangle whose restricted N is r: lower <= min d . N (<= |N|) and
@@ -287,12 +402,21 @@ class Prover {
                       double u, double v, ChartValue& out) {
     // N = r_u x r_v, N_u = r_uu x r_v + r_u x r_uv, N_v = r_uv x r_v + r_u x r_vv: one pass
     // over the control net (the Bernstein forms of N cost several times more).
-    const PatchDerivatives r = derivativesToSecondOrder(*data.patch, u, v);
-    const Vec3 n = cross(r.u, r.v);
+    // On a patch with collapsed edges q and its derivatives come from the Bernstein forms
+    // (N vanishes on the apex row; g is the same for q, N's positive multiple, inside).
+    Vec3 n, nu, nv;
+    if (data.divided) {
+      n = evaluateVector(data.n, u, v);
+      nu = evaluateVector(data.nu, u, v);
+      nv = evaluateVector(data.nv, u, v);
+    } else {
+      const PatchDerivatives r = derivativesToSecondOrder(*data.patch, u, v);
+      n = cross(r.u, r.v);
+      nu = cross(r.uu, r.v) + cross(r.u, r.uv);
+      nv = cross(r.uv, r.v) + cross(r.u, r.vv);
+    }
     const double w = dot(n, sc);
     if (!(w > 1e-3 * norm(n))) return false;
-    const Vec3 nu = cross(r.uu, r.v) + cross(r.u, r.uv);
-    const Vec3 nv = cross(r.uv, r.v) + cross(r.u, r.vv);
     out.ga = dot(n, e1) / w;
     out.gb = dot(n, e2) / w;
     const double wu = dot(nu, sc), wv = dot(nv, sc);
@@ -305,7 +429,8 @@ class Prover {
 
   // Newton's method with backtracking on g(u, v) = 0 from (u, v), kept in [0, 1]^2.
   static bool newton(const PatchData& data, double sign, const Vec3& c, const Vec3& e1,
-                     const Vec3& e2, double& u, double& v, double& stretch) {
+                     const Vec3& e2, double& u, double& v, double& stretch,
+                     double& largestStretch) {
     const Vec3 sc = sign * c;
     ChartValue g;
     if (!chartAt(data, sc, e1, e2, u, v, g)) return false;
@@ -316,6 +441,7 @@ class Prover {
         const double det = std::abs(g.j11 * g.j22 - g.j12 * g.j21);
         const double disc = std::sqrt(std::max(0.0, f * f - 4.0 * det * det));
         stretch = std::sqrt(std::max(0.0, 0.5 * (f - disc)));
+        largestStretch = std::sqrt(std::max(0.0, 0.5 * (f + disc)));
         return true;
       }
       const double det = g.j11 * g.j22 - g.j12 * g.j21;
@@ -355,12 +481,12 @@ class Prover {
     const auto [e1, e2] = frameAbout(c);
     std::vector<Preimage> found;
     auto tryFrom = [&](std::size_t patch, double sign, double u, double v) {
-      double stretch = 0.0;
-      if (!newton(patches_[patch], sign, c, e1, e2, u, v, stretch)) return;
+      double stretch = 0.0, largest = 0.0;
+      if (!newton(patches_[patch], sign, c, e1, e2, u, v, stretch, largest)) return;
       for (const Preimage& p : found) {
         if (samePreimage(p, patch, sign, u, v)) return;
       }
-      found.push_back(Preimage{patch, sign, u, v, stretch});
+      found.push_back(Preimage{patch, sign, u, v, stretch, largest});
     };
     for (const Preimage& h : hints) tryFrom(h.patch, h.sign, h.u, h.v);
     for (const Seed& seed : seeds_) {
@@ -384,7 +510,8 @@ class Prover {
     return found;
   }
 
-  // Tries rectangles about each preimage not in `tried`.
+  // Tries rectangles about each preimage not in `tried`: at each size, the assembly the
+  // rectangle grows into across glued edges (assemble), then the rectangle alone.
   bool proveCap(const Vec3& c, double radius, const std::vector<Preimage>& preimages,
                 const std::vector<Preimage>& tried) {
     const double tanR = std::tan(radius) * (1.0 + 4.0 * kUnitRoundoff);
@@ -397,141 +524,374 @@ class Prover {
       double previous = -1.0;
       for (double factor : {2.0, 4.0, 8.0}) {
         if (cells_ >= options_.maxCells) return false;
-        const double h = std::clamp(p.stretch > 0.0 ? factor * tanR / p.stretch : 0.5,
-                                    kSmallestHalfWidth, 0.5);
+        const double h = dyadicFloor(std::clamp(
+            p.stretch > 0.0 ? factor * tanR / p.stretch : 0.5, kSmallestHalfWidth, 0.5));
         if (h == previous) continue;
         previous = h;
         auto window = [h](double t) {
-          const double lo = std::clamp(t - h, 0.0, 1.0 - 2.0 * h);
-          return std::pair<double, double>{lo, h >= 0.5 ? 1.0 : lo + 2.0 * h};
+          if (h >= 0.5) return std::pair<double, double>{0.0, 1.0};
+          const double lo = std::floor(std::clamp(t - h, 0.0, 1.0 - 2.0 * h) / kGrid) * kGrid;
+          return std::pair<double, double>{lo, lo + 2.0 * h};
         };
-        const auto [u0, u1] = window(p.u);
-        const auto [v0, v1] = window(p.v);
-        const CellResult r = testCell(p.patch, p.sign, u0, u1, v0, v1, c, e1, e2, tanR);
-        if (r == CellResult::proven) return true;
+        Rect r;
+        r.patch = p.patch;
+        std::tie(r.u0, r.u1) = window(p.u);
+        std::tie(r.v0, r.v1) = window(p.v);
+        // Along a collapsed edge of constant normal (an apex row), a strip the whole edge
+        // long, as deep as the Gauss map's steepest stretch asks (the apex's preimage is the
+        // whole row, so the smallest stretch says nothing there).
+        const PatchData& data = patches_[p.patch];
+        const double depthFrom = p.largestStretch > 0.0
+                                     ? factor * tanR / p.largestStretch
+                                     : 0.5;
+        for (int side = 0; side < 4; ++side) {
+          if (!onEdge(r, side) || !data.collapsed[side] || !data.constantEdge[side]) continue;
+          const double along = side == 3   ? p.u
+                               : side == 1 ? 1.0 - p.u
+                               : side == 0 ? p.v
+                                           : 1.0 - p.v;
+          const double depth =
+              std::min(1.0, std::ceil((along + 2.0 * depthFrom) / kGrid) * kGrid);
+          if (side == 3) r.u1 = std::max(r.u0, depth), r.v0 = 0.0, r.v1 = 1.0;
+          if (side == 1) r.u0 = std::min(r.u1, 1.0 - depth), r.v0 = 0.0, r.v1 = 1.0;
+          if (side == 0) r.v1 = std::max(r.v0, depth), r.u0 = 0.0, r.u1 = 1.0;
+          if (side == 2) r.v0 = std::min(r.v1, 1.0 - depth), r.u0 = 0.0, r.u1 = 1.0;
+        }
+        const std::vector<Rect> assembly = assemble(r);
+        if (assembly.size() > 1 &&
+            testAssembly(assembly, c, e1, e2, tanR) == CellResult::proven) {
+          ++glued_;
+          return true;
+        }
+        if (cells_ >= options_.maxCells) return false;
+        if (testAssembly({r}, c, e1, e2, tanR) == CellResult::proven) return true;
       }
     }
     return false;
   }
 
-  // The winding test of the rectangle [u0, u1] x [v0, v1] of `patch` for the cap of centre c
-  // and chart radius tanR, with normals s n (see the header's steps 1 to 4).
-  CellResult testCell(std::size_t patch, double sign, double u0, double u1, double v0, double v1,
-                      const Vec3& c, const Vec3& e1, const Vec3& e2, double tanR) {
-    ++cells_;
-    const PatchData& data = patches_[patch];
-    std::array<Bernstein2, 3> r;
-    for (int k = 0; k < 3; ++k) r[k] = restrictTo(data.n[k], u0, u1, v0, v1);
-    const Vec3 centre = evaluateVector(r, 0.5, 0.5);
-    if (!(norm(centre) > 0.0)) return ++skipped_, CellResult::skipped;
-    const Vec3 d = normalized(centre);
-    double lower = 0.0, perpendicular = 0.0;
-    coneBounds(r, d, data.coefficientError, lower, perpendicular);
-    if (!(lower > 0.0)) return ++skipped_, CellResult::skipped;
-    // Step 1: the normals lie within rho of d, and s n . c >= cmin > 0.
-    const double rho = spreadOf(lower, perpendicular);
-    if (rho > options_.maxCellSpreadRad) return CellResult::failed;
-    const double offset = angleBetween(sign * d, c) + 1e-12;
-    if (offset + rho > kHalfPi - kChartMargin) return CellResult::failed;
-    const double cmin = std::cos(offset + rho) * (1.0 - 1e-12);
-    const double stretch = 1.0 / (cmin * cmin);
-    // Step 2 and 3 along the four edges, counter-clockwise in (u, v); each edge's Bernstein
-    // coefficients are the boundary row or column of r (reversed: the parameter runs back),
-    // so consecutive edges share their corner coefficient exactly.
+  static double dyadicFloor(double h) { return std::exp2(std::floor(std::log2(h))); }
+
+  // Side k of r lies on patch edge k (0: v = 0, 1: u = 1, 2: v = 1, 3: u = 0).
+  static bool onEdge(const Rect& r, int side) {
+    switch (side) {
+      case 0: return r.v0 == 0.0;
+      case 1: return r.u1 == 1.0;
+      case 2: return r.v1 == 1.0;
+      default: return r.u0 == 0.0;
+    }
+  }
+
+  // The sides of r, other than `entry`, that lie on a glued edge of its patch and are not
+  // glued within the assembly yet.
+  std::vector<int> gluableSides(const Rect& r, int entry) const {
+    std::vector<int> sides;
+    for (int k = 0; k < 4; ++k) {
+      if (k == entry || r.glued[k] || !onEdge(r, k)) continue;
+      if (patches_[r.patch].collapsed[k] || glues_[r.patch * 4 + k].empty()) continue;
+      sides.push_back(k);
+    }
+    return sides;
+  }
+
+  // The rectangle across side `side` of r (on a glued edge): the side's parameter interval
+  // mapped to the partner edge, as deep into the partner as r is across the side; its
+  // orientation chosen so that the two glued sides cancel in the boundary chain.
+  Rect crossSide(const Rect& r, int side, int& entry) const {
+    const Glue& g = glues_[r.patch * 4 + side].front();
+    const bool alongU = side == 0 || side == 2;
+    const double t0 = alongU ? r.u0 : r.v0, t1 = alongU ? r.u1 : r.v1;
+    const double depth = alongU ? r.v1 - r.v0 : r.u1 - r.u0;
+    const double s0 = g.reversed ? 1.0 - t1 : t0, s1 = g.reversed ? 1.0 - t0 : t1;
+    Rect out;
+    out.patch = g.patch;
+    switch (g.edge) {
+      case 0: out.u0 = s0, out.u1 = s1, out.v0 = 0.0, out.v1 = depth; break;
+      case 1: out.u0 = 1.0 - depth, out.u1 = 1.0, out.v0 = s0, out.v1 = s1; break;
+      case 2: out.u0 = s0, out.u1 = s1, out.v0 = 1.0 - depth, out.v1 = 1.0; break;
+      default: out.u0 = 0.0, out.u1 = depth, out.v0 = s0, out.v1 = s1; break;
+    }
+    // Counter-clockwise, sides 0 and 1 run with the edge parameter, sides 2 and 3 against.
+    const int directionA = side < 2 ? 1 : -1;
+    const int mapped = g.reversed ? -directionA : directionA;
+    const int directionB = g.edge < 2 ? 1 : -1;
+    out.orientation = mapped == directionB ? -r.orientation : r.orientation;
+    entry = g.edge;
+    return out;
+  }
+
+  // r0 and the rectangles reached from it across glued edges: a walk across one glued side
+  // after another (each rectangle having exactly one more), closing into a cycle around a
+  // vertex (or an apex's strips) when it returns to r0, else a chain, walked both ways.
+  std::vector<Rect> assemble(const Rect& r0) const {
+    std::vector<Rect> rects{r0};
+    const std::vector<int> start = gluableSides(r0, -1);
+    bool closed = false;
+    for (std::size_t way = 0; way < start.size() && way < 2 && !closed; ++way) {
+      std::size_t current = 0;
+      int side = start[way];
+      if (rects[0].glued[side]) break;
+      while (rects.size() < kMaxAssembly) {
+        int entry = 0;
+        Rect next = crossSide(rects[current], side, entry);
+        if (next.same(rects[0])) {
+          if (!rects[0].glued[entry] && next.orientation == rects[0].orientation &&
+              current != 0) {
+            rects[current].glued[side] = true;
+            rects[0].glued[entry] = true;
+            closed = true;
+          }
+          break;
+        }
+        const bool repeated = std::any_of(rects.begin(), rects.end(),
+                                          [&](const Rect& x) { return x.same(next); });
+        if (repeated) break;
+        rects[current].glued[side] = true;
+        next.glued[entry] = true;
+        rects.push_back(next);
+        current = rects.size() - 1;
+        const std::vector<int> exits = gluableSides(next, entry);
+        if (exits.size() != 1) break;
+        side = exits[0];
+      }
+    }
+    return rects;
+  }
+
+  // The winding test of an assembly of rectangles for the cap of centre c and chart radius
+  // tanR (see the header's steps 1 to 4): each rectangle's normals s n in the chart's
+  // hemisphere, every side not glued within the assembly and not an apex row of constant
+  // normal sampled, and the sum of their turning angles about 0 (each side's times its
+  // rectangle's orientation) a nonzero multiple of 2 pi.
+  CellResult testAssembly(const std::vector<Rect>& rects, const Vec3& c, const Vec3& e1,
+                          const Vec3& e2, double tanR) {
+    struct Prepared {
+      std::array<Bernstein2, 3> r;
+      Vec3 d;
+      double stretch = 0.0;
+    };
+    std::vector<Prepared> prepared(rects.size());
+    for (std::size_t i = 0; i < rects.size(); ++i) {
+      ++cells_;
+      const Rect& rect = rects[i];
+      const PatchData& data = patches_[rect.patch];
+      Prepared& pr = prepared[i];
+      for (int k = 0; k < 3; ++k) {
+        pr.r[k] = restrictTo(data.n[k], rect.u0, rect.u1, rect.v0, rect.v1);
+      }
+      const Vec3 centre = evaluateVector(pr.r, 0.5, 0.5);
+      if (!(norm(centre) > 0.0)) return ++skipped_, CellResult::skipped;
+      pr.d = normalized(centre);
+      double lower = 0.0, perpendicular = 0.0;
+      coneBounds(pr.r, pr.d, data.coefficientError, lower, perpendicular);
+      if (!(lower > 0.0)) return ++skipped_, CellResult::skipped;
+      // Step 1: the normals lie within rho of d, and s n . c >= cmin > 0.
+      const double rho = spreadOf(lower, perpendicular);
+      if (rho > options_.maxCellSpreadRad) return CellResult::failed;
+      const double sign = dot(pr.d, c) >= 0.0 ? 1.0 : -1.0;
+      const double offset = angleBetween(sign * pr.d, c) + 1e-12;
+      if (offset + rho > kHalfPi - kChartMargin) return CellResult::failed;
+      const double cmin = std::cos(offset + rho) * (1.0 - 1e-12);
+      pr.stretch = 1.0 / (cmin * cmin);
+    }
+    double turn = 0.0, correction = 0.0;
+    for (std::size_t i = 0; i < rects.size(); ++i) {
+      const Rect& rect = rects[i];
+      const PatchData& data = patches_[rect.patch];
+      std::array<bool, 4> sampled{};
+      for (int side = 0; side < 4; ++side) {
+        const bool apex = onEdge(rect, side) && data.collapsed[side] && data.constantEdge[side];
+        sampled[side] = !rect.glued[side] && !apex;
+      }
+      for (int side = 0; side < 4; ++side) {
+        if (!sampled[side]) continue;
+        // A side's end shared with a sampled side of the same rectangle is the same computed
+        // point (the corner coefficient); elsewhere it meets another rectangle's side or an
+        // apex point, and the computed ends may differ by their errors.
+        const bool freeStart = !sampled[(side + 3) % 4], freeEnd = !sampled[(side + 1) % 4];
+        double sideTurn = 0.0, sideCorrection = 0.0;
+        const CellResult r = sampleSide(prepared[i], data, side, c, e1, e2, tanR, freeStart,
+                                        freeEnd, sideTurn, sideCorrection);
+        if (r != CellResult::proven) return r;
+        turn += rect.orientation * sideTurn;
+        correction += sideCorrection;
+      }
+    }
+    // Step 4: the sides' images form a cycle (the boundary of the assembly's chain, glued
+    // sides cancelled, apex rows being points), so its turning is 2 pi k, k an integer; the
+    // computed sum is within `correction` of it (computed vs true ends of the sides).
+    if (!(correction < 1.0)) return CellResult::failed;
+    const double winding = turn / (2.0 * std::numbers::pi);
+    const double rounded = std::round(winding);
+    if (std::abs(turn - 2.0 * std::numbers::pi * rounded) > correction + 0.25) {
+      return CellResult::failed;  // cannot happen
+    }
+    return rounded != 0.0 ? CellResult::proven : CellResult::failed;
+  }
+
+  // Steps 2 and 3 along one side of a prepared rectangle (counter-clockwise in (u, v); its
+  // Bernstein coefficients are the boundary row or column of r, reversed where the parameter
+  // runs back). `turn` receives the turning angle of the sampled polygon about 0, and
+  // `correction` a bound on the angle between the computed and the true ends that are
+  // flagged free.
+  CellResult sampleSide(const auto& pr, const PatchData& data, int side, const Vec3& c,
+                        const Vec3& e1, const Vec3& e2, double tanR, bool freeStart,
+                        bool freeEnd, double& turn, double& correction) {
+    const auto& r = pr.r;
+    const Vec3& d = pr.d;
+    const double stretch = pr.stretch;
     const int m = r[0].degreeU, n = r[0].degreeV;
     auto coefficient = [&](int i, int j) {
       const std::size_t at = static_cast<std::size_t>(i * (n + 1) + j);
       return Vec3{r[0].coefficients[at], r[1].coefficients[at], r[2].coefficients[at]};
     };
-    std::vector<Vec2> polygon;
     std::vector<Vec3> edge;
+    if (side == 0) {
+      for (int i = 0; i <= m; ++i) edge.push_back(coefficient(i, 0));
+    } else if (side == 1) {
+      for (int j = 0; j <= n; ++j) edge.push_back(coefficient(m, j));
+    } else if (side == 2) {
+      for (int i = m; i >= 0; --i) edge.push_back(coefficient(i, n));
+    } else {
+      for (int j = n; j >= 0; --j) edge.push_back(coefficient(0, j));
+    }
+    const int q = static_cast<int>(edge.size()) - 1;
+    if (q + 1 > 64) return CellResult::failed;
+    double edgeLower = std::numeric_limits<double>::infinity(), largest = 0.0, slope = 0.0;
+    for (int i = 0; i <= q; ++i) {
+      edgeLower = std::min(edgeLower, dot(d, edge[i]));
+      largest = std::max({largest, std::abs(edge[i].x), std::abs(edge[i].y),
+                          std::abs(edge[i].z)});
+      if (i < q) slope = std::max(slope, norm(edge[i + 1] - edge[i]));
+    }
+    edgeLower -= kSqrt3 * data.coefficientError + 4.0 * kUnitRoundoff * norm(edge[0]) +
+                 4.0 * kUnitRoundoff * largest * kSqrt3;
+    if (!(edgeLower > 0.0)) return ++skipped_, CellResult::skipped;
+    // |dN/dt| <= q max |c_{i+1} - c_i| (the derivative's coefficients), rounding added.
+    const double derivative =
+        q * (slope * (1.0 + 4.0 * kUnitRoundoff) + 2.0 * kSqrt3 * data.coefficientError);
+    const double lipschitz = derivative / edgeLower * stretch * (1.0 + 1e-12);
+    // A sample's chart point is off by at most eps: N by gamma_{3q} of its largest
+    // coefficient plus the coefficients' rounding, the direction by twice that over |N|,
+    // the chart by its stretch, and the chart's own arithmetic.
+    const double eps =
+        4.0 * (2.0 * kSqrt3 * (gamma(3 * q + 4) * largest + data.coefficientError) /
+                   edgeLower * stretch +
+               16.0 * kUnitRoundoff * stretch);
+    if (!(tanR > 4.0 * eps)) return CellResult::failed;
+    auto chart = [&](double t) {
+      ++samples_;
+      const Vec3 x = deCasteljau(edge, t);
+      const double w = dot(x, c);
+      return Vec2{dot(x, e1) / w, dot(x, e2) / w};
+    };
+    double ta = 0.0;
+    Vec2 pa = chart(0.0);
+    turn = 0.0;
+    correction = 0.0;
+    if (freeStart) correction += std::asin(std::min(1.0, eps / norm(pa)));
     std::vector<std::pair<double, Vec2>> pending;
-    for (int side = 0; side < 4; ++side) {
-      edge.clear();
-      if (side == 0) {
-        for (int i = 0; i <= m; ++i) edge.push_back(coefficient(i, 0));
-      } else if (side == 1) {
-        for (int j = 0; j <= n; ++j) edge.push_back(coefficient(m, j));
-      } else if (side == 2) {
-        for (int i = m; i >= 0; --i) edge.push_back(coefficient(i, n));
-      } else {
-        for (int j = n; j >= 0; --j) edge.push_back(coefficient(0, j));
+    for (int k = kInitialSegments; k >= 1; --k) {
+      const double t = double(k) / kInitialSegments;
+      pending.emplace_back(t, chart(t));
+    }
+    std::size_t cellSamples = 0;
+    while (!pending.empty()) {
+      const auto [tb, pb] = pending.back();
+      if (!(norm(pa) > tanR + 2.0 * eps)) return CellResult::failed;  // inside the cap
+      if (norm(pa) + norm(pb) - 2.0 * tanR - 2.0 * eps > lipschitz * (tb - ta)) {
+        // Each turn is below pi: the segment misses the disk about 0.
+        turn += std::atan2(cross(pa, pb), dot(pa, pb));
+        ta = tb;
+        pa = pb;
+        pending.pop_back();
+        continue;
       }
-      const int q = static_cast<int>(edge.size()) - 1;
-      if (q + 1 > 64) return CellResult::failed;
-      double edgeLower = std::numeric_limits<double>::infinity(), largest = 0.0, slope = 0.0;
-      for (int i = 0; i <= q; ++i) {
-        edgeLower = std::min(edgeLower, dot(d, edge[i]));
-        largest = std::max({largest, std::abs(edge[i].x), std::abs(edge[i].y),
-                            std::abs(edge[i].z)});
-        if (i < q) slope = std::max(slope, norm(edge[i + 1] - edge[i]));
+      if (tb - ta < kNarrowestSegment || ++cellSamples > kMaxSamplesPerCell) {
+        return CellResult::failed;
       }
-      edgeLower -= kSqrt3 * data.coefficientError + 4.0 * kUnitRoundoff * norm(edge[0]) +
-                   4.0 * kUnitRoundoff * largest * kSqrt3;
-      if (!(edgeLower > 0.0)) return ++skipped_, CellResult::skipped;
-      // |dN/dt| <= q max |c_{i+1} - c_i| (the derivative's coefficients), rounding added.
-      const double derivative =
-          q * (slope * (1.0 + 4.0 * kUnitRoundoff) + 2.0 * kSqrt3 * data.coefficientError);
-      const double lipschitz = derivative / edgeLower * stretch * (1.0 + 1e-12);
-      // A sample's chart point is off by at most eps: N by gamma_{3q} of its largest
-      // coefficient plus the coefficients' rounding, the direction by twice that over |N|,
-      // the chart by its stretch, and the chart's own arithmetic.
-      const double eps =
-          4.0 * (2.0 * kSqrt3 * (gamma(3 * q + 4) * largest + data.coefficientError) /
-                     edgeLower * stretch +
-                 16.0 * kUnitRoundoff * stretch);
-      if (!(tanR > 4.0 * eps)) return CellResult::failed;
-      auto chart = [&](double t) {
-        ++samples_;
-        const Vec3 x = deCasteljau(edge, t);
-        const double w = dot(x, c);
-        return Vec2{dot(x, e1) / w, dot(x, e2) / w};
-      };
-      double ta = 0.0;
-      Vec2 pa = chart(0.0);
-      if (side == 0) polygon.push_back(pa);
-      pending.clear();
-      for (int k = kInitialSegments; k >= 1; --k) {
-        const double t = double(k) / kInitialSegments;
-        pending.emplace_back(t, chart(t));
-      }
-      std::size_t cellSamples = 0;
-      while (!pending.empty()) {
-        const auto [tb, pb] = pending.back();
-        if (!(norm(pa) > tanR + 2.0 * eps)) return CellResult::failed;  // inside the cap
-        if (norm(pa) + norm(pb) - 2.0 * tanR - 2.0 * eps > lipschitz * (tb - ta)) {
-          polygon.push_back(pb);
-          ta = tb;
-          pa = pb;
-          pending.pop_back();
+      const double tm = 0.5 * (ta + tb);
+      pending.emplace_back(tm, chart(tm));
+    }
+    if (!(norm(pa) > tanR + 2.0 * eps)) return CellResult::failed;
+    if (freeEnd) correction += std::asin(std::min(1.0, eps / norm(pa)));
+    return CellResult::proven;
+  }
+
+  // The glue table: every ordered pair of distinct non-collapsed patch edges of equal degree
+  // whose q rows are parallel as polynomials (certified by parallelRows), the partner's
+  // parameter reversed or not. A cheap test at five parameters screens the pairs first.
+  void buildGlues() {
+    glues_.assign(patches_.size() * 4, {});
+    std::vector<std::vector<Vec3>> rows(patches_.size() * 4);
+    for (std::size_t p = 0; p < patches_.size(); ++p) {
+      for (int e = 0; e < 4; ++e) rows[p * 4 + e] = edgeRow(patches_[p].n, e);
+    }
+    for (std::size_t a = 0; a < patches_.size() * 4; ++a) {
+      if (patches_[a / 4].collapsed[a % 4]) continue;
+      for (std::size_t b = 0; b < patches_.size() * 4; ++b) {
+        if (a == b || patches_[b / 4].collapsed[b % 4] || rows[a].size() != rows[b].size()) {
           continue;
         }
-        if (tb - ta < kNarrowestSegment || ++cellSamples > kMaxSamplesPerCell) {
-          return CellResult::failed;
+        for (bool reversed : {false, true}) {
+          std::vector<Vec3> rb = rows[b];
+          if (reversed) std::reverse(rb.begin(), rb.end());
+          bool close = true;
+          for (double t : {0.0, 0.25, 0.5, 0.75, 1.0}) {
+            const Vec3 x = deCasteljau(rows[a], t), y = deCasteljau(rb, t);
+            close = close && norm(cross(x, y)) <= 1e-9 * norm(x) * norm(y) && norm(x) > 0.0;
+          }
+          if (!close) continue;
+          if (!parallelRows(rows[a], rb, patches_[a / 4].coefficientError,
+                            patches_[b / 4].coefficientError)) {
+            continue;
+          }
+          const std::vector<Vec3> ca = edgeControl(*patches_[a / 4].patch, int(a % 4));
+          std::vector<Vec3> cb = edgeControl(*patches_[b / 4].patch, int(b % 4));
+          if (reversed) std::reverse(cb.begin(), cb.end());
+          glues_[a].push_back(Glue{b / 4, int(b % 4), reversed, ca == cb});
         }
-        const double tm = 0.5 * (ta + tb);
-        pending.emplace_back(tm, chart(tm));
       }
+      // Shared edges (the surface's own seams) first, then by partner: deterministic.
+      std::stable_sort(glues_[a].begin(), glues_[a].end(),
+                       [](const Glue& x, const Glue& y) { return x.shared && !y.shared; });
     }
-    // Step 4: the winding number of the closed polygon about 0 (its last vertex is the
-    // first: the corner coefficient is shared). No segment comes within tanR of 0, so each
-    // turn is below pi and the sum is an integer multiple of 2 pi to rounding.
-    double turn = 0.0;
-    for (std::size_t i = 0; i + 1 < polygon.size(); ++i) {
-      turn += std::atan2(cross(polygon[i], polygon[i + 1]), dot(polygon[i], polygon[i + 1]));
+  }
+
+  // True when the polynomials a(t) and b(t) (Bernstein coefficients a_i, b_i, degree d) are
+  // parallel: every Bernstein coefficient of a x b, sum over i + j = k of
+  // C(d, i) C(d, j) / C(2d, k) (a_i x b_j), is within its rounding bound of zero (the
+  // coefficients' own errors ea, eb per component through the products, and the sum's
+  // rounding). Then a(t) x b(t) = 0 up to that rounding for all t.
+  static bool parallelRows(const std::vector<Vec3>& a, const std::vector<Vec3>& b, double ea,
+                           double eb) {
+    const int d = static_cast<int>(a.size()) - 1;
+    double largestA = 0.0, largestB = 0.0;
+    for (const Vec3& x : a) largestA = std::max(largestA, norm(x));
+    for (const Vec3& x : b) largestB = std::max(largestB, norm(x));
+    for (int k = 0; k <= 2 * d; ++k) {
+      Vec3 c{0.0, 0.0, 0.0};
+      double absolute = 0.0;
+      for (int i = std::max(0, k - d); i <= std::min(k, d); ++i) {
+        const double w = binomial(d, i) * binomial(d, k - i) / binomial(2 * d, k);
+        c = c + w * cross(a[i], b[k - i]);
+        absolute += w * norm(a[i]) * norm(b[k - i]);
+      }
+      const double tolerance = gamma(2 * d + 12) * absolute +
+                               4.0 * kSqrt3 * (ea * largestB + eb * largestA);
+      if (!(norm(c) <= tolerance)) return false;
     }
-    const double winding = turn / (2.0 * std::numbers::pi);
-    const double rounded = std::round(winding);
-    if (std::abs(winding - rounded) > 0.25) return CellResult::failed;  // cannot happen
-    return rounded != 0.0 ? CellResult::proven : CellResult::failed;
+    return true;
   }
 
   NormalCoverageOptions options_;
+  std::vector<std::vector<Glue>> glues_;
   std::vector<PatchData> patches_;
   std::vector<Seed> seeds_;
   std::size_t cells_ = 0;
   std::size_t skipped_ = 0;
   std::size_t samples_ = 0;
+  std::size_t glued_ = 0;
 };
 
 }  // namespace

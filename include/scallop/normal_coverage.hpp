@@ -8,14 +8,16 @@
 // Contract
 // --------
 // Input:  a surface of Bezier patches (surface.hpp); regular patches are the design case.
-//         Patches whose r_u x r_v vanishes somewhere (an apex: a collapsed boundary row) are
-//         accepted: the cells where the lower bound on |r_u x r_v| fails are skipped, and
-//         the other cells are used. Malformed patches (degree < 1, wrong control count)
-//         throw scallop::Error, as do invalid options.
+//         Patches with collapsed boundary rows (apexes) are accepted: the normal there is
+//         the limit q / |q| (bezier.hpp's normalDirectionPolynomials, q = N with the
+//         collapsed edges' factors divided out); rectangles where |q| is not bounded below
+//         are skipped. Malformed patches (degree < 1, wrong control count) throw
+//         scallop::Error, as do invalid options.
 // Output: NormalCoverage. proven == true is a proof (rigorous up to the floating-point
 //         rounding bounds stated below) that every direction m has m or -m among the unit
-//         normals n = N / |N|, N = r_u x r_v, of the patches on [0, 1]^2. proven == false
-//         names a direction whose cap could not be proven (not a claim that it is uncovered).
+//         normals n = q / |q| (= N / |N|, N = r_u x r_v, wherever N != 0; on an apex row its
+//         limit) of the patches on [0, 1]^2. proven == false names a direction whose cap
+//         could not be proven (not a claim that it is uncovered).
 // Method (degree theory): the directions up to sign are the three cube faces x, y, z = 1
 //         projected to the sphere (every m has m or -m on one); each face is a square of
 //         the gnomonic chart, subdivided into quadrants depth first. A quadrant's spherical
@@ -43,30 +45,70 @@
 //         4. that winding number is nonzero. Then every direction of C is a value of the
 //            continuous map s n on the disk D (a map of a disk whose boundary winds about a
 //            point takes that point), i.e. a normal of the patch up to sign.
+// Glued assemblies (directions whose preimages lie on seams, seam crossings, apexes, or
+//         free edges): D may be a chain c = sum_i o_i D_i of rectangles D_i of patches P_i,
+//         orientations o_i = +-1, steps 1 - 3 holding on each (each with its own sign s_i),
+//         where some sides are glued in pairs and some are apex rows:
+//         - two patch edges are glued when q along them, the second's parameter t or 1 - t,
+//           is parallel as a polynomial: every Bernstein coefficient of q_A x q_B (degree 2d)
+//           lies within its rounding bound of 0 (gamma_{2d+12} of the coefficients' absolute
+//           sums, plus the q coefficients' own bounds through the products). Then the unit
+//           normals s_A n_A and s_B n_B, both in the chart's open hemisphere and parallel,
+//           are equal along the glued sides. The surface's seams (control points equal bit
+//           for bit, G1 within rounding: the teapot's meridians and parallels) are glued so,
+//           and so are free edges whose normals are antipodal (the teapot bottom's rim with
+//           the opposite quarter's), the two sides being s = +1 and s = -1;
+//         - a side on a collapsed edge (its control points all equal) whose q coefficients
+//           are all parallel (within their rounding) is an apex row: s n is constant on it;
+//         - glued sides have equal parameter intervals (bounds are multiples of 2^-20, so
+//           1 - t is exact) and the orientations are chosen so that they cancel in the
+//           boundary of c.
+//         Then the map F = s_i n_i on the space X (the D_i, glued sides identified) is
+//         continuous into the hemisphere, and the boundary of c, less the apex rows (constant
+//         1-simplices, boundaries of constant 2-simplices at a value of F), is a cycle made
+//         of the remaining sides. If F missed a point y of the cap's disk, F_* of that chain
+//         would lie in R^2 \ {y} and the cycle's winding about y would be 0. So the sides are
+//         sampled as in step 3 and their turning angles about 0, times o_i, summed: the sum
+//         is 2 pi k up to the turn between the computed and the true ends of sides that meet
+//         another rectangle's side or an apex (bounded by asin(eps / |x|) each, in all < 1
+//         rad); k != 0 proves the cap. The assembly grows from the rectangle about a
+//         preimage: across its sides on glued edges, to the partner's rectangle with the same
+//         interval and depth, one side at a time, closing into a cycle around a vertex (the 4
+//         quarters at a seam crossing, the bottom's rim corners) or around an apex (strips
+//         the whole apex row long, the knob's top and the bottom's centre), or else a chain
+//         (one seam), at most 8 rectangles. The surface's shared edges are tried first.
 //         Rectangles are chosen, not searched blindly: Newton's method on g(s n(u, v)) = 0
 //         from the parent cap's preimages (first) and from a fixed 4 x 4 grid of seed cells
-//         per patch whose normal cone holds c (when those fail) finds the preimages of c, and rectangles centred there (moved inside
-//         the patch) are tried at sizes from the chart Jacobian's smallest singular value;
-//         any heuristic failure costs completeness, never soundness. A cap not proven is
+//         per patch whose normal cone holds c (when those fail) finds the preimages of c, and
+//         rectangles centred there (moved inside the patch; sizes dyadic) are tried at sizes
+//         from the chart Jacobian's smallest singular value (strips along an apex row: depth
+//         from the largest), first as the assembly they grow into, then alone; any heuristic
+//         failure costs completeness, never soundness. A cap not proven is
 //         split in four, to maxCapDepth; a cap at that depth, or a centre with no preimage
 //         found, ends the proof with that direction reported.
 // Rounding: the restricted Bernstein coefficients carry bernstein.hpp's bounds
-//         (gamma_{6m} + gamma_{6n} of the largest |coefficient| of N, times 4), which are
-//         subtracted from the lower bounds and added to the derivative bounds; the sampled
-//         chart points carry eps (their evaluation error through 1 / |N| and the chart,
-//         times 4); the cap's radius is rounded up. Those are the "stated rounding".
-// Limits: a direction whose every preimage lies on a patch boundary (a seam of a G1
-//         surface: on a convex closed surface every direction has one preimage, so the seams'
-//         images), on a fold (a parabolic line, where the Gauss map is not locally onto), or
-//         only at points where N = 0 cannot be proven by single-patch rectangles; closed
-//         surfaces whose patches' normals overlap across seams (each seam direction also
-//         normal inside some patch) and whose extreme points are not degenerate are proven.
-// Complexity: per cap O(P) for the seed cones (P patches) plus a few Newton solves and
-//         rectangle tests, each O(mn(m + n)) for the restriction plus O(samples) for the
-//         winding; budgets: maxCaps caps and maxCells rectangle tests (past either: not
-//         proven, reason budget). Deterministic: the same input gives the same result.
-//         Measured (tests/normal_coverage_test.cpp, default options): closed C2 tori of 32
-//         bicubic patches 0.13 - 0.17 s (2,500 - 3,500 caps), 35 patches 0.05 s.
+//         (gamma_{6m} + gamma_{6n} of the largest |coefficient| of N or q, times 4; on patches
+//         with apex rows plus the edge division's: its dropped row, below unitNormal's
+//         threshold, and one rounding per division, amplified by the degree per division),
+//         which are subtracted from the lower bounds and added to the derivative bounds; the
+//         sampled chart points carry eps (their evaluation error through 1 / |q| and the
+//         chart, times 4); the cap's radius is rounded up. The glue certificate and the apex
+//         rows' constancy are identities up to those coefficient bounds: a seam whose normals
+//         differ by a kink below rounding (the teapot's parallels, G1 in decimal, differ by
+//         ~1e-16 in binary) is glued. Those are the "stated rounding".
+// Limits: a direction whose every preimage lies on a fold (a parabolic line, where the Gauss
+//         map is not locally onto; e.g. the teapot rim's straight-up direction, normal only on
+//         its top parallel, which the Gauss map folds to a point), on a free edge with no
+//         antipodal partner, at a corner whose walk does not close, or only at points where
+//         q = 0 is not proven. Not proven: "teapot-rim", "teapot-spout".
+// Complexity: the glue table costs O(P^2) edge pairs (a 5-point screen, then O(d^2) for the
+//         certificate); per cap O(P) for the seed cones (P patches) plus a few Newton solves
+//         and assembly tests, each O(mn(m + n)) per rectangle for the restriction plus
+//         O(samples) for the winding; budgets: maxCaps caps and maxCells rectangle tests
+//         (past either: not proven, reason budget). Deterministic: the same input gives the
+//         same result. Measured (tests/normal_coverage_test.cpp, default options, Release,
+//         2 shared cores): closed C2 tori of 32 bicubic patches 0.06 - 0.17 s, the teapot
+//         (32 patches) 0.32 s, its lid 0.84 s, its bottom 0.25 s.
 
 #include <cstddef>
 
@@ -104,6 +146,7 @@ struct NormalCoverage {
   std::size_t cells = 0;         ///< rectangles tested
   std::size_t skippedCells = 0;  ///< rectangles rejected for |N| not bounded below
   std::size_t samples = 0;       ///< edge samples evaluated
+  std::size_t gluedCaps = 0;     ///< caps proven by an assembly of glued rectangles
   int deepestCap = 0;            ///< deepest subdivision level reached
   double smallestCapRad = 0.0;   ///< smallest proven cap's radius (0 if none)
   /// Not proven: the centre of the cap where the proof stopped, and its radius (no claim
