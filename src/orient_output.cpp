@@ -497,7 +497,9 @@ std::string omegaFill(const OptimalSlicing& result, const SphereView& view,
     }
     polygons.push_back(std::move(polygon));
   }
-  if (polygons.empty()) return {};
+  // No loops: Omega has no complement left within its tolerance (methods covered and
+  // lattice), so the whole visible hemisphere is Omega.
+  if (polygons.empty() && !inOmega(result.gaussMap, view.toViewer)) return {};
   std::string d;
   for (const std::vector<Vec2>& polygon : polygons) d += pathData(polygon, true) + " ";
   const bool parity = evenOddContains(polygons, {view.cx, view.cy});
@@ -972,15 +974,32 @@ std::string gaussMapSphereSvg(const OptimalSlicing& result) {
   const std::string legendSvg = legend(entries, legendTop, legendBottom);
   const double pageHeight = legendBottom + 8.0;
 
-  const std::string title =
+  std::string title =
       fmt::format("Symmetrized Gauss map \u03a9 and the optimal slicing circle: N* = {}, "
                   "\u03b1* = {}",
                   vectorLabel(result.normal), degreesLabel(result.alphaRad));
-  const std::array<std::string, 2> subtitle = {
+  std::array<std::string, 2> subtitle = {
       std::string("Every surface normal \u00b1n is at least \u03b1* from N*: the circle of "
                   "angular radius \u03b1* around N* touches \u03a9 without entering it."),
       fmt::format("{}. Pole p = {}: a surface normal.", certificateLabel(result),
                   vectorLabel(result.pole, 3))};
+  if (result.method == "covered") {
+    title = "Symmetrized Gauss map \u03a9: it covers the whole sphere, so no slicing direction "
+            "exists (\u03b1* = 0)";
+    subtitle = {fmt::format("Proven: every direction or its opposite is a surface normal ({} "
+                            "caps of directions, each inside the image of patch rectangles).",
+                            result.coverage.caps),
+                fmt::format("Pole p = {}: a surface normal.", vectorLabel(result.pole, 3))};
+  } else if (result.method == "lattice") {
+    title = fmt::format("Symmetrized Gauss map \u03a9: no direction free within the tolerance; "
+                        "best found N = {}, \u03b1 = {}",
+                        vectorLabel(result.normal), degreesLabel(result.alphaRad));
+    subtitle = {fmt::format("No proof that \u03a9 covers the sphere (none found near {}): N is "
+                            "the best direction found, its \u03b1 certified.",
+                            vectorLabel(result.coverage.unprovenDirection, 3)),
+                fmt::format("{}. Pole p = {}: a surface normal.", certificateLabel(result),
+                            vectorLabel(result.pole, 3))};
+  }
 
   std::string svg = pageStart(pageHeight, title);
   svg += heading(title, subtitle);
@@ -1039,6 +1058,13 @@ std::string stereographicSvg(const OptimalSlicing& result) {
         "It maximises \u03b1 = atan(2R / (\u03c1\u00b2 \u2212 R\u00b2 + 1)), not R. {} boundary "
         "loops ({} segments), {} medial-axis edges.",
         result.gaussMap.loops.size(), result.gaussMap.boundarySegments, result.medialAxisEdges);
+  } else if (result.method == "covered" || result.method == "lattice") {
+    subtitle[0] = result.method == "covered"
+                      ? std::string("\u03a9 covers the whole plane (proven): no complement, no "
+                                    "medial axis, no slicing direction (\u03b1* = 0).")
+                      : std::string("\u03a9 leaves no complement within its tolerance: no medial "
+                                    "axis; no proof that it covers the sphere either.");
+    subtitle[1] = "Only \u03a9 (all of the plane), the unit circle and the origin are drawn.";
   } else {
     subtitle[0] = fmt::format("The Gauss image has no interior (method: {}): no medial axis; "
                               "\u03b1* = {} found on the sphere.",

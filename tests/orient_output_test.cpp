@@ -274,6 +274,27 @@ TEST(OrientSvg, TitlesGiveNStarAndAlphaStar) {
   EXPECT_NE(stereographicSvg(result).find(alpha), std::string::npos);
 }
 
+// A surface whose normals cover the sphere (the whole teapot, proven): the figures say so,
+// shade the whole sphere (Omega has no boundary: one shaded disk per view), and draw no
+// boundary; the JSON carries the proof.
+TEST(OrientSvg, CoveredSphereSaysSoAndIsShadedWhole) {
+  const OptimalSlicing result = scallop::optimalSlicing(scallop::exampleSurface("teapot"));
+  ASSERT_EQ(result.method, "covered");
+  const std::string sphere = gaussMapSphereSvg(result);
+  EXPECT_NE(sphere.find("it covers the whole sphere, so no slicing direction exists"), std::string::npos);
+  std::size_t shaded = 0;
+  const std::string fill = "<path class=\"omega\" clip-path";  // a panel's shading
+  for (std::size_t at = sphere.find(fill); at != std::string::npos; at = sphere.find(fill, at + 1)) {
+    ++shaded;
+  }
+  EXPECT_EQ(shaded, 2u);
+  EXPECT_NE(stereographicSvg(result).find("covers the whole plane (proven)"), std::string::npos);
+  const Json doc = Json::parse(orientationToJson(result, 0.5));
+  EXPECT_EQ(doc.at("method"), "covered");
+  EXPECT_TRUE(doc.at("coverage").at("proven").get<bool>());
+  EXPECT_EQ(doc.at("alpha_deg").get<double>(), 0.0);
+}
+
 TEST(OrientSvg, NonFiniteInputIsAnErrorNotAPicture) {
   OptimalSlicing result = exampleResult("paper-2");
   result.normal.x = std::numeric_limits<double>::quiet_NaN();
