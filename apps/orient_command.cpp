@@ -176,8 +176,12 @@ void addOrientCommand(CLI::App& app) {
       "Input: JSON {\"units\": \"in\"|\"mm\", \"patches\": [{\"degree\": [m, n], "
       "\"control_points\": [[[x, y, z], ... n + 1], ... m + 1 rows]}, ...]}, or .bpt text (the "
       "patch count, then per patch a line 'm n' and (m + 1)(n + 1) lines 'x y z', in inches); "
-      "every patch must be regular (r_u x r_v != 0).\n"
-      "Example: scallop orient --example paper-2 --json out.json --svg-dir figs");
+      "every patch must be regular (r_u x r_v != 0, except on a boundary row or column "
+      "collapsed to one point, an apex, where the normal's limit is taken).\n"
+      "When the Gauss map leaves no direction free, 'no slicing direction exists' is said only "
+      "with a proof that the normals cover the sphere; otherwise the best direction found, "
+      "certified.\n"
+      "Example: scallop orient --example teapot-body --json out.json --svg-dir figs");
 
   addSurfaceSourceOptions(*orient, options->surface,
                           "surface file (JSON or .bpt, Bezier patches); - reads standard input",
