@@ -190,14 +190,44 @@ TEST(NormalCoverage, TeapotClosedGroupsAreProven) {
   }
 }
 
-// Not proven (a limit, no claim that they are uncovered): the rim's straight-up direction is
-// a normal only along its top parallel, a circle the Gauss map folds to one point; the spout's
-// (0, 1, 0).
-TEST(NormalCoverage, TeapotRimAndSpoutAreNotProven) {
-  for (const char* name : {"teapot-rim", "teapot-spout"}) {
-    const NormalCoverage c = scallop::proveNormalsCoverSphere(scallop::exampleSurface(name));
-    EXPECT_FALSE(c.proven) << name;
+// The rim's straight-up direction is a normal only along its top parallel (u = 1/2 of each
+// quarter, the profile's z symmetric), a circle of constant normal that the Gauss map folds
+// to one point: proven by the ring of strips 1/2 <= u <= 1/2 + d glued across the quarters'
+// seams, whose constant side drops out of the boundary.
+TEST(NormalCoverage, TeapotRimIsProvenAcrossItsFold) {
+  const Surface s = scallop::exampleSurface("teapot-rim");
+  expectProven(s, "teapot-rim");
+  EXPECT_GT(scallop::proveNormalsCoverSphere(s).gluedCaps, 0u);
+}
+
+// The rim with its top made asymmetric (the second profile row's z moved by 1e-3: in every
+// quarter, still a surface of revolution whose fold parallel is no longer at a dyadic u; or
+// in one interior control point only): no iso-parameter line of constant normal is certified
+// there, and nothing else proves the straight-up direction, so no proof (a limit, not a claim
+// that it is uncovered).
+TEST(NormalCoverage, AsymmetricRimTopIsNotProven) {
+  for (double dz : {1e-3, -1e-3}) {
+    Surface everyQuarter = scallop::exampleSurface("teapot-rim");
+    for (BezierPatch& p : everyQuarter.patches) {
+      for (int j = 0; j <= 3; ++j) p.control[4 + j].z += dz;
+    }
+    Surface onePoint = scallop::exampleSurface("teapot-rim");
+    onePoint.patches[0].control[5].z += dz;
+    for (const Surface& s : {everyQuarter, onePoint}) {
+      const NormalCoverage c = scallop::proveNormalsCoverSphere(s);
+      EXPECT_FALSE(c.proven) << dz;
+      EXPECT_NEAR(std::abs(c.unprovenDirection.z), 1.0, 1e-4) << dz;
+    }
   }
+}
+
+// Not proven (a limit, no claim that it is uncovered): the spout's (0, 1, 0), a normal only
+// at isolated points (the side line's ends on the free edges and the seam between the lower
+// and upper spout), with no glued assembly winding about it.
+TEST(NormalCoverage, TeapotSpoutIsNotProven) {
+  const NormalCoverage c = scallop::proveNormalsCoverSphere(scallop::exampleSurface("teapot-spout"));
+  EXPECT_FALSE(c.proven);
+  EXPECT_NEAR(std::abs(c.unprovenDirection.y), 1.0, 1e-4);
 }
 
 // Each direction of a proven surface is a normal: the gauss_map module's membership test
@@ -321,7 +351,8 @@ TEST(NormalCoverage, TinyBudgetsStopWithoutAProof) {
 
 TEST(NormalCoverage, IsDeterministic) {
   for (const Surface& s : {torus(7, 5), torus(8, 4, 0.2, 5), scallop::exampleSurface("paper-1"),
-                           scallop::exampleSurface("teapot")}) {
+                           scallop::exampleSurface("teapot"),
+                           scallop::exampleSurface("teapot-rim")}) {
     const NormalCoverage a = scallop::proveNormalsCoverSphere(s);
     const NormalCoverage b = scallop::proveNormalsCoverSphere(s);
     EXPECT_EQ(a.proven, b.proven);
