@@ -120,8 +120,16 @@
 //         dyadic parameter (the teapot rim's top parallel is one and is proven; the same rim
 //         with its profile's top moved off u = 1/2 is not), on a free edge with no antipodal
 //         partner, at a corner whose walk does not close, or only at points where q = 0 is not
-//         proven. Not proven: "teapot-spout" (its (0, 1, 0) is a normal only at isolated
-//         points: the side line's ends on the free edges and on the lower / upper seam).
+//         proven. Not proven, and not provable by any assembly: "teapot-spout". Its
+//         +-(0, 1, 0) is a normal only at the ends of the side lines v = 1/2: on the free
+//         edges (where the spout joins the body, and the lip) and on the seams between the
+//         lower and upper spout, where the Gauss map folds (local degree 0: a small circle's
+//         image winds 0 times about it). An assembly whose boundary avoids a cap holding
+//         (0, 1, 0) keeps the free-edge points off it, so its winding about (0, 1, 0) is the
+//         sum of those local degrees, 0; the caps are closed and (0, 1, 0) is a corner of
+//         four. The directions about it are normals (tests: gauss_map's membership test,
+//         even in the lens between a free edge's image and its mirror's, which the seam's
+//         fold covers).
 // Complexity: the glue table costs O(P^2) edge pairs (a 5-point screen, then O(d^2) for the
 //         certificate); per cap O(P) for the seed cones (P patches) plus a few Newton solves
 //         and assembly tests, each O(mn(m + n)) per rectangle for the restriction plus
