@@ -85,7 +85,7 @@ struct Rect {
   double orientation = 1.0;
   std::array<bool, 4> glued{};
   // Whether sides of constant normal (certified on the rectangle's own coefficients) are
-  // dropped from the boundary: set for the strips along fold lines (proveCap).
+  // dropped from the boundary: set for the strips along fold lines (proveAcrossFold).
   bool constantSides = false;
   bool same(const Rect& r) const {
     return patch == r.patch && u0 == r.u0 && u1 == r.u1 && v0 == r.v0 && v1 == r.v1;
@@ -243,15 +243,7 @@ class Prover {
         if (!data.collapsed[edge]) continue;
         // Constant normal along the apex row: every coefficient of q there parallel to the
         // first (to within their rounding), so q(t) = lambda(t) a_0 on the edge.
-        const std::vector<Vec3> row = edgeRow(data.n, edge);
-        bool parallel = norm(row[0]) > 0.0;
-        for (const Vec3& a : row) {
-          const double tolerance =
-              2.0 * kSqrt3 * data.coefficientError * (norm(a) + norm(row[0])) +
-              gamma(8) * norm(a) * norm(row[0]);
-          parallel = parallel && norm(cross(a, row[0])) <= tolerance && dot(a, row[0]) > 0.0;
-        }
-        data.constantEdge[edge] = parallel;
+        data.constantEdge[edge] = constantRow(data.rows[edge], data.coefficientError);
       }
       patches_.push_back(std::move(data));
     }
@@ -371,11 +363,6 @@ class Prover {
     result.skippedCells = skipped_;
     result.samples = samples_;
     result.gluedCaps = glued_;
-  }
-
-  // The Bernstein coefficients of r along side `side` of its rectangle (any direction).
-  static std::vector<Vec3> sideRow(const std::array<Bernstein2, 3>& r, int side) {
-    return edgeRow(r, side);
   }
 
   // True when the polynomial with Bernstein coefficients `row` (each component within
@@ -668,7 +655,7 @@ class Prover {
       r[k] = axis == 0 ? restrictTo(data.n[k], t, 1.0, 0.0, 1.0)
                        : restrictTo(data.n[k], 0.0, 1.0, t, 1.0);
     }
-    const bool constant = constantRow(sideRow(r, axis == 0 ? 3 : 0), data.coefficientError);
+    const bool constant = constantRow(edgeRow(r, axis == 0 ? 3 : 0), data.coefficientError);
     constantLines_.emplace(key, constant);
     return constant;
   }
@@ -808,7 +795,7 @@ class Prover {
         // A side of constant normal (an apex row, or a fold line of constant normal such as
         // the teapot rim's top parallel): its image is one point, dropped like an apex row.
         sampled[side] = !rect.glued[side] && !apex &&
-                        !(rect.constantSides && constantRow(sideRow(prepared[i].r, side),
+                        !(rect.constantSides && constantRow(edgeRow(prepared[i].r, side),
                                                             data.coefficientError));
       }
       for (int side = 0; side < 4; ++side) {
@@ -931,26 +918,25 @@ class Prover {
   // parameter reversed or not. A cheap test at five parameters screens the pairs first.
   void buildGlues() {
     glues_.assign(patches_.size() * 4, {});
-    std::vector<std::vector<Vec3>> rows(patches_.size() * 4);
-    for (std::size_t p = 0; p < patches_.size(); ++p) {
-      for (int e = 0; e < 4; ++e) rows[p * 4 + e] = edgeRow(patches_[p].n, e);
-    }
+    auto rows = [&](std::size_t edge) -> const std::vector<Vec3>& {
+      return patches_[edge / 4].rows[edge % 4];
+    };
     for (std::size_t a = 0; a < patches_.size() * 4; ++a) {
       if (patches_[a / 4].collapsed[a % 4]) continue;
       for (std::size_t b = 0; b < patches_.size() * 4; ++b) {
-        if (a == b || patches_[b / 4].collapsed[b % 4] || rows[a].size() != rows[b].size()) {
+        if (a == b || patches_[b / 4].collapsed[b % 4] || rows(a).size() != rows(b).size()) {
           continue;
         }
         for (bool reversed : {false, true}) {
-          std::vector<Vec3> rb = rows[b];
+          std::vector<Vec3> rb = rows(b);
           if (reversed) std::reverse(rb.begin(), rb.end());
           bool close = true;
           for (double t : {0.0, 0.25, 0.5, 0.75, 1.0}) {
-            const Vec3 x = deCasteljau(rows[a], t), y = deCasteljau(rb, t);
+            const Vec3 x = deCasteljau(rows(a), t), y = deCasteljau(rb, t);
             close = close && norm(cross(x, y)) <= 1e-9 * norm(x) * norm(y) && norm(x) > 0.0;
           }
           if (!close) continue;
-          if (!parallelRows(rows[a], rb, patches_[a / 4].coefficientError,
+          if (!parallelRows(rows(a), rb, patches_[a / 4].coefficientError,
                             patches_[b / 4].coefficientError)) {
             continue;
           }
