@@ -93,9 +93,10 @@
 //         (the Jacobian's largest singular value) of it, to a t in (0, 1) whose line u = t
 //         has q at its two ends parallel (a screen) and q's coefficients along it parallel
 //         (restricted to the line, cached: the screen; each strip certifies its own side), the
-//         strips t <= u <= t + d and t - d <= u <= t, 0 <= v <= 1 (the preimage's side first;
-//         d = |u - t| plus the apex strips' depth, up to a multiple of 2^-20, at most 1/2) are grown across glued edges into a
-//         ring (the rim's four quarters) and tested with their constant sides dropped.
+//         strips t <= u <= t + d and t - d <= u <= t, 0 <= v <= 1 (the preimage's side
+//         first; d = |u - t| plus the apex strips' depth, up to a multiple of 2^-20, at most
+//         1/2) are grown across glued edges into a ring (the rim's four quarters) and tested
+//         with their constant sides dropped.
 //         Rectangles are chosen, not searched blindly: Newton's method on g(s n(u, v)) = 0
 //         from the parent cap's preimages (first) and from a fixed 4 x 4 grid of seed cells
 //         per patch whose normal cone holds c (when those fail) finds the preimages of c, and
