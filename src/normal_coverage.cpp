@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
+#include <map>
 #include <numbers>
 #include <string>
 #include <tuple>
@@ -62,6 +63,8 @@ struct PatchData {
   // equal (an apex row), and q's coefficients on it all parallel (its normal is constant).
   std::array<bool, 4> collapsed{};
   std::array<bool, 4> constantEdge{};
+  // q's Bernstein coefficients along each patch edge (edgeRow), for the fold screen.
+  std::array<std::vector<Vec3>, 4> rows;
 };
 
 // A patch edge glued to another (or to another edge of the same patch): q along the two
@@ -81,6 +84,9 @@ struct Rect {
   double u0 = 0.0, u1 = 1.0, v0 = 0.0, v1 = 1.0;
   double orientation = 1.0;
   std::array<bool, 4> glued{};
+  // Whether sides of constant normal (certified on the rectangle's own coefficients) are
+  // dropped from the boundary: set for the strips along fold lines (proveAcrossFold).
+  bool constantSides = false;
   bool same(const Rect& r) const {
     return patch == r.patch && u0 == r.u0 && u1 == r.u1 && v0 == r.v0 && v1 == r.v1;
   }
@@ -91,6 +97,8 @@ struct Rect {
 constexpr double kGrid = 1.0 / (1 << 20);
 // Largest rectangles in an assembly (a cycle around a vertex has 4 on the teapot).
 constexpr std::size_t kMaxAssembly = 8;
+// Fold lines of constant normal are looked for at multiples of 2^-kFoldLevels.
+constexpr int kFoldLevels = 10;
 
 // The coefficients of q on patch edge `edge`, its parameter increasing.
 std::vector<Vec3> edgeRow(const std::array<Bernstein2, 3>& r, int edge) {
@@ -228,21 +236,14 @@ class Prover {
         }
       }
       for (int edge = 0; edge < 4; ++edge) {
+        data.rows[edge] = edgeRow(data.n, edge);
         const std::vector<Vec3> points = edgeControl(patch, edge);
         data.collapsed[edge] = std::all_of(points.begin(), points.end(),
                                            [&](const Vec3& p) { return p == points[0]; });
         if (!data.collapsed[edge]) continue;
         // Constant normal along the apex row: every coefficient of q there parallel to the
         // first (to within their rounding), so q(t) = lambda(t) a_0 on the edge.
-        const std::vector<Vec3> row = edgeRow(data.n, edge);
-        bool parallel = norm(row[0]) > 0.0;
-        for (const Vec3& a : row) {
-          const double tolerance =
-              2.0 * kSqrt3 * data.coefficientError * (norm(a) + norm(row[0])) +
-              gamma(8) * norm(a) * norm(row[0]);
-          parallel = parallel && norm(cross(a, row[0])) <= tolerance && dot(a, row[0]) > 0.0;
-        }
-        data.constantEdge[edge] = parallel;
+        data.constantEdge[edge] = constantRow(data.rows[edge], data.coefficientError);
       }
       patches_.push_back(std::move(data));
     }
@@ -362,6 +363,21 @@ class Prover {
     result.skippedCells = skipped_;
     result.samples = samples_;
     result.gluedCaps = glued_;
+  }
+
+  // True when the polynomial with Bernstein coefficients `row` (each component within
+  // `coefficientError` of the true one) has a constant direction: every true coefficient is
+  // parallel to the first (|a_j x a_0| within the bound of the computed ones' errors through
+  // the product and its rounding) and on its side (a_j . a_0 > 0), as for an apex row; so
+  // q(t) = lambda(t) a_0 with lambda > 0 and the unit normal is a_0 / |a_0| along it.
+  static bool constantRow(const std::vector<Vec3>& row, double coefficientError) {
+    if (!(norm(row[0]) > 0.0)) return false;
+    for (const Vec3& a : row) {
+      const double tolerance = 2.0 * kSqrt3 * coefficientError * (norm(a) + norm(row[0])) +
+                               gamma(8) * norm(a) * norm(row[0]);
+      if (!(norm(cross(a, row[0])) <= tolerance && dot(a, row[0]) > 0.0)) return false;
+    }
+    return true;
   }
 
   // Over the rectangle whose restricted N is r: lower <= min d . N (<= |N|) and
@@ -567,7 +583,81 @@ class Prover {
         if (testAssembly({r}, c, e1, e2, tanR) == CellResult::proven) return true;
       }
     }
+    for (const Preimage& p : preimages) {
+      const bool seen = std::any_of(tried.begin(), tried.end(), [&](const Preimage& q) {
+        return samePreimage(q, p.patch, p.sign, p.u, p.v);
+      });
+      if (!seen && proveAcrossFold(c, e1, e2, tanR, p)) return true;
+    }
     return false;
+  }
+
+  // Folds of constant normal: when the preimage p lies near an iso-parameter line u = t or
+  // v = t (t dyadic, 2^-kFoldLevels at the finest) along which the patch's normal is constant
+  // (the teapot rim's top parallel: the Gauss map folds it to one point), strips t <= u <=
+  // t + d (or t - d <= u <= t) the whole line long, grown across glued edges into a ring;
+  // the constant side drops out of the boundary (testAssembly), the far sides wind about the
+  // fold's image. The preimage's side of the line first, then the other.
+  bool proveAcrossFold(const Vec3& c, const Vec3& e1, const Vec3& e2, double tanR,
+                       const Preimage& p) {
+    for (int axis = 0; axis < 2; ++axis) {
+      const double at = axis == 0 ? p.u : p.v;
+      double previousLine = -1.0;
+      for (int level = 1; level <= kFoldLevels; ++level) {
+        const double scale = std::exp2(level);
+        const double t = std::round(at * scale) / scale;
+        // A fold's strip reaches past the preimage by `across` (below) at most 8 tanR /
+        // largestStretch: lines farther away are not tried.
+        if (t == previousLine || t <= 0.0 || t >= 1.0) continue;
+        if (p.largestStretch > 0.0 && std::abs(at - t) > 8.0 * tanR / p.largestStretch) continue;
+        previousLine = t;
+        if (!constantLine(p.patch, axis, t)) continue;
+        double previousDepth = -1.0;
+        for (double factor : {2.0, 4.0, 8.0}) {
+          if (cells_ >= options_.maxCells) return false;
+          const double across = p.largestStretch > 0.0 ? factor * tanR / p.largestStretch : 0.5;
+          const double depth = std::min(
+              0.5, std::ceil((std::abs(at - t) + across) / kGrid) * kGrid);
+          if (depth == previousDepth) continue;
+          previousDepth = depth;
+          for (const double side : {at >= t ? 1.0 : -1.0, at >= t ? -1.0 : 1.0}) {
+            Rect r;
+            r.patch = p.patch;
+            r.constantSides = true;
+            const double lo = side > 0.0 ? t : std::max(0.0, t - depth);
+            const double hi = side > 0.0 ? std::min(1.0, t + depth) : t;
+            if (axis == 0) r.u0 = lo, r.u1 = hi; else r.v0 = lo, r.v1 = hi;
+            if (testAssembly(assemble(r), c, e1, e2, tanR) == CellResult::proven) {
+              ++glued_;
+              return true;
+            }
+          }
+        }
+      }
+    }
+    return false;
+  }
+
+  // Whether q is constant in direction along the whole line u = t (axis 0) or v = t (axis 1)
+  // of the patch: a screen (the certificate is testAssembly's, on each strip's own
+  // coefficients), cached.
+  bool constantLine(std::size_t patch, int axis, double t) {
+    // Cheap screen first: q at the line's two ends (on the patch's edges) parallel.
+    const PatchData& data = patches_[patch];
+    const Vec3 a = deCasteljau(data.rows[axis == 0 ? 0 : 3], t);
+    const Vec3 b = deCasteljau(data.rows[axis == 0 ? 2 : 1], t);
+    if (!(norm(cross(a, b)) <= 1e-9 * norm(a) * norm(b) && dot(a, b) > 0.0)) return false;
+    const auto key = std::make_tuple(patch, axis, t);
+    const auto it = constantLines_.find(key);
+    if (it != constantLines_.end()) return it->second;
+    std::array<Bernstein2, 3> r;
+    for (int k = 0; k < 3; ++k) {
+      r[k] = axis == 0 ? restrictTo(data.n[k], t, 1.0, 0.0, 1.0)
+                       : restrictTo(data.n[k], 0.0, 1.0, t, 1.0);
+    }
+    const bool constant = constantRow(edgeRow(r, axis == 0 ? 3 : 0), data.coefficientError);
+    constantLines_.emplace(key, constant);
+    return constant;
   }
 
   static double dyadicFloor(double h) { return std::exp2(std::floor(std::log2(h))); }
@@ -605,6 +695,7 @@ class Prover {
     const double s0 = g.reversed ? 1.0 - t1 : t0, s1 = g.reversed ? 1.0 - t0 : t1;
     Rect out;
     out.patch = g.patch;
+    out.constantSides = r.constantSides;
     switch (g.edge) {
       case 0: out.u0 = s0, out.u1 = s1, out.v0 = 0.0, out.v1 = depth; break;
       case 1: out.u0 = 1.0 - depth, out.u1 = 1.0, out.v0 = s0, out.v1 = s1; break;
@@ -701,7 +792,11 @@ class Prover {
       std::array<bool, 4> sampled{};
       for (int side = 0; side < 4; ++side) {
         const bool apex = onEdge(rect, side) && data.collapsed[side] && data.constantEdge[side];
-        sampled[side] = !rect.glued[side] && !apex;
+        // A side of constant normal (an apex row, or a fold line of constant normal such as
+        // the teapot rim's top parallel): its image is one point, dropped like an apex row.
+        sampled[side] = !rect.glued[side] && !apex &&
+                        !(rect.constantSides && constantRow(edgeRow(prepared[i].r, side),
+                                                            data.coefficientError));
       }
       for (int side = 0; side < 4; ++side) {
         if (!sampled[side]) continue;
@@ -823,26 +918,25 @@ class Prover {
   // parameter reversed or not. A cheap test at five parameters screens the pairs first.
   void buildGlues() {
     glues_.assign(patches_.size() * 4, {});
-    std::vector<std::vector<Vec3>> rows(patches_.size() * 4);
-    for (std::size_t p = 0; p < patches_.size(); ++p) {
-      for (int e = 0; e < 4; ++e) rows[p * 4 + e] = edgeRow(patches_[p].n, e);
-    }
+    auto rows = [&](std::size_t edge) -> const std::vector<Vec3>& {
+      return patches_[edge / 4].rows[edge % 4];
+    };
     for (std::size_t a = 0; a < patches_.size() * 4; ++a) {
       if (patches_[a / 4].collapsed[a % 4]) continue;
       for (std::size_t b = 0; b < patches_.size() * 4; ++b) {
-        if (a == b || patches_[b / 4].collapsed[b % 4] || rows[a].size() != rows[b].size()) {
+        if (a == b || patches_[b / 4].collapsed[b % 4] || rows(a).size() != rows(b).size()) {
           continue;
         }
         for (bool reversed : {false, true}) {
-          std::vector<Vec3> rb = rows[b];
+          std::vector<Vec3> rb = rows(b);
           if (reversed) std::reverse(rb.begin(), rb.end());
           bool close = true;
           for (double t : {0.0, 0.25, 0.5, 0.75, 1.0}) {
-            const Vec3 x = deCasteljau(rows[a], t), y = deCasteljau(rb, t);
+            const Vec3 x = deCasteljau(rows(a), t), y = deCasteljau(rb, t);
             close = close && norm(cross(x, y)) <= 1e-9 * norm(x) * norm(y) && norm(x) > 0.0;
           }
           if (!close) continue;
-          if (!parallelRows(rows[a], rb, patches_[a / 4].coefficientError,
+          if (!parallelRows(rows(a), rb, patches_[a / 4].coefficientError,
                             patches_[b / 4].coefficientError)) {
             continue;
           }
@@ -888,6 +982,7 @@ class Prover {
   std::vector<std::vector<Glue>> glues_;
   std::vector<PatchData> patches_;
   std::vector<Seed> seeds_;
+  std::map<std::tuple<std::size_t, int, double>, bool> constantLines_;
   std::size_t cells_ = 0;
   std::size_t skipped_ = 0;
   std::size_t samples_ = 0;

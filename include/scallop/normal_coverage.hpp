@@ -60,14 +60,25 @@
 //           the opposite quarter's), the two sides being s = +1 and s = -1;
 //         - a side on a collapsed edge (its control points all equal) whose q coefficients
 //           are all parallel (within their rounding) is an apex row: s n is constant on it;
+//         - so is a side of a fold strip (below) whose own restricted q coefficients are all
+//           parallel to the first and on its side (|a_j x a_0| within the bound of their
+//           rounding, a_j . a_0 > 0): q = lambda a_0 with lambda > 0 along it, its unit
+//           normal constant (the teapot rim's top parallel, u = 1/2 of each quarter);
 //         - glued sides have equal parameter intervals (bounds are multiples of 2^-20, so
 //           1 - t is exact) and the orientations are chosen so that they cancel in the
 //           boundary of c.
 //         Then the map F = s_i n_i on the space X (the D_i, glued sides identified) is
-//         continuous into the hemisphere, and the boundary of c, less the apex rows (constant
-//         1-simplices, boundaries of constant 2-simplices at a value of F), is a cycle made
-//         of the remaining sides. If F missed a point y of the cap's disk, F_* of that chain
-//         would lie in R^2 \ {y} and the cycle's winding about y would be 0. So the sides are
+//         continuous into the hemisphere, and the boundary of c, less the constant sides
+//         (apex rows and fold sides: F o sigma is a constant 1-simplex, the boundary of the
+//         constant 2-simplex at that value), is a cycle made of the remaining sides. If F
+//         missed a point y of the cap's disk, F_* c would be a 2-chain in R^2 \ {y}, its
+//         boundary F_* (boundary of c) = (the remaining sides' images) + (boundaries of
+//         constant 2-simplices, also in R^2 \ {y}, since their value is F's), so the
+//         remaining cycle would bound there and its winding about y would be 0. This holds
+//         for every y, the constant sides' value e included (F takes e, so it misses no
+//         point equal to e): only the sampled sides must avoid the cap's disk, which is why a
+//         fold's strips must close into a ring (a lone strip's sides meet the fold side, at
+//         e, inside the cap). So the sides are
 //         sampled as in step 3 and their turning angles about 0, times o_i, summed: the sum
 //         is 2 pi k up to the turn between the computed and the true ends of sides that meet
 //         another rectangle's side or an apex (bounded by asin(eps / |x|) each, in all < 1
@@ -77,6 +88,15 @@
 //         quarters at a seam crossing, the bottom's rim corners) or around an apex (strips
 //         the whole apex row long, the knob's top and the bottom's centre), or else a chain
 //         (one seam), at most 8 rectangles. The surface's shared edges are tried first.
+//         Fold strips (tried last for each preimage, when the rectangles about it fail): when
+//         the preimage's u (or v) rounds, at a dyadic level 1 .. 10 and within 8 tan(r) /
+//         (the Jacobian's largest singular value) of it, to a t in (0, 1) whose line u = t
+//         has q at its two ends parallel (a screen) and q's coefficients along it parallel
+//         (restricted to the line, cached: the screen; each strip certifies its own side), the
+//         strips t <= u <= t + d and t - d <= u <= t, 0 <= v <= 1 (the preimage's side
+//         first; d = |u - t| plus the apex strips' depth, up to a multiple of 2^-20, at most
+//         1/2) are grown across glued edges into a ring (the rim's four quarters) and tested
+//         with their constant sides dropped.
 //         Rectangles are chosen, not searched blindly: Newton's method on g(s n(u, v)) = 0
 //         from the parent cap's preimages (first) and from a fixed 4 x 4 grid of seed cells
 //         per patch whose normal cone holds c (when those fail) finds the preimages of c, and
@@ -97,18 +117,28 @@
 //         differ by a kink below rounding (the teapot's parallels, G1 in decimal, differ by
 //         ~1e-16 in binary) is glued. Those are the "stated rounding".
 // Limits: a direction whose every preimage lies on a fold (a parabolic line, where the Gauss
-//         map is not locally onto; e.g. the teapot rim's straight-up direction, normal only on
-//         its top parallel, which the Gauss map folds to a point), on a free edge with no
-//         antipodal partner, at a corner whose walk does not close, or only at points where
-//         q = 0 is not proven. Not proven: "teapot-rim", "teapot-spout".
+//         map is not locally onto) other than an iso-parameter line of constant normal at a
+//         dyadic parameter (the teapot rim's top parallel is one and is proven; the same rim
+//         with its profile's top moved off u = 1/2 is not), on a free edge with no antipodal
+//         partner, at a corner whose walk does not close, or only at points where q = 0 is not
+//         proven. Not proven, and not provable by any assembly: "teapot-spout". Its
+//         +-(0, 1, 0) is a normal only at the ends of the side lines v = 1/2: on the free
+//         edges (where the spout joins the body, and the lip) and on the seams between the
+//         lower and upper spout, where the Gauss map folds (local degree 0: a small circle's
+//         image winds 0 times about it). An assembly whose boundary avoids a cap holding
+//         (0, 1, 0) keeps the free-edge points off it, so its winding about (0, 1, 0) is the
+//         sum of those local degrees, 0; the caps are closed and (0, 1, 0) is a corner of
+//         four. The directions about it are normals (tests: gauss_map's membership test,
+//         even in the lens between a free edge's image and its mirror's, which the seam's
+//         fold covers).
 // Complexity: the glue table costs O(P^2) edge pairs (a 5-point screen, then O(d^2) for the
 //         certificate); per cap O(P) for the seed cones (P patches) plus a few Newton solves
 //         and assembly tests, each O(mn(m + n)) per rectangle for the restriction plus
 //         O(samples) for the winding; budgets: maxCaps caps and maxCells rectangle tests
 //         (past either: not proven, reason budget). Deterministic: the same input gives the
 //         same result. Measured (tests/normal_coverage_test.cpp, default options, Release,
-//         2 shared cores): closed C2 tori of 32 bicubic patches 0.06 - 0.17 s, the teapot
-//         (32 patches) 0.32 s, its lid 0.84 s, its bottom 0.25 s.
+//         2 shared cores): closed C2 tori of 32 bicubic patches 0.05 - 0.07 s, the teapot
+//         (32 patches) 0.17 s, its lid 0.84 s, its bottom 0.25 s, its rim 0.02 s.
 
 #include <cstddef>
 
