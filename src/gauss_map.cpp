@@ -310,6 +310,13 @@ class BoundaryBand {
   std::unordered_map<std::int64_t, std::vector<std::uint32_t>> cells_;
 };
 
+// Work bounds: halvings of one curve of normals (measured at 4e-7 degree on the paper's
+// surfaces, ~100,000 boundary segments, and at 1e-6 degree on the whole teapot: at most
+// 7,700 and 11,700), and quadtree cells of one patch (at most 88 and 100 there). Past them
+// the map stops with an error naming the patch.
+constexpr std::size_t kMaxCurveSamples = std::size_t{1} << 21;
+constexpr std::size_t kMaxPatchCells = std::size_t{1} << 20;
+
 // Samples normal curves n(s), s in [0, 1] (along a cell edge or a patch boundary), by
 // halving until the polygon is within `tol` of the curve and no segment spans more than
 // `maxStep` (so that a wiggle between samples is not missed). The polygon is used as
@@ -323,13 +330,6 @@ class BoundaryBand {
 // within `tol` of the curve's point at the middle parameter, as the sphere chord's middle
 // is. The rule depends on the end parameters only (through the normals there and at the
 // middle), so two cells sampling a shared edge agree vertex for vertex.
-// Work bounds: halvings of one curve of normals (the paper's surfaces need a few hundred at
-// 0.5 degree, ~30,000 at 4e-7 degree), and quadtree cells of one patch (40 to 90 on the
-// paper's surfaces, ~600 on a teapot patch at the finest tolerance). Past them the map
-// stops with an error naming the patch.
-constexpr std::size_t kMaxCurveSamples = std::size_t{1} << 21;
-constexpr std::size_t kMaxPatchCells = std::size_t{1} << 20;
-
 struct NormalSampler {
   double tol;
   Rotation3 toPoleFrame;
@@ -423,7 +423,6 @@ struct NormalSampler {
 // ---------------------------------------------------------------------------------------
 
 constexpr double kRegularCellSpread = 0.5;  // radians
-
 
 // The coarse map of the band (see symmetrizedGaussMap): its tolerance (radians), used when
 // the tolerance asked for is at least kCoarseBandFactor times finer; the band's half-width
