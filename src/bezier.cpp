@@ -258,19 +258,42 @@ std::array<Bernstein2, 3> normalPolynomials(const BezierPatch& patch) {
           subtract(multiply(ru[0], rv[1]), multiply(ru[1], rv[0]))};
 }
 
-Bernstein2 gaussianCurvatureNumerator(const BezierPatch& patch) {
+namespace {
+
+// (r_uu . N)(r_vv . N) - (r_uv . N)^2 and a bound on its terms' size,
+// |r_uu . N| |r_vv . N| + |r_uv . N|^2 (their coefficients' largest magnitudes).
+std::pair<Bernstein2, double> curvatureNumeratorAndBound(const BezierPatch& patch) {
   const std::array<Bernstein2, 3> r = coordinatePolynomials(patch);
   const std::array<Bernstein2, 3> normal = normalPolynomials(patch);  // (2m - 1, 2n - 1)
   const std::array<Bernstein2, 3> ru = derivativesU(r);
   const std::array<Bernstein2, 3> ruv = derivativesV(ru);  // (m - 1, n - 1)
   const Bernstein2 mixed = dot(ruv, normal);               // (3m - 2, 3n - 2)
   const Bernstein2 mixedSquared = multiply(mixed, mixed);  // (6m - 4, 6n - 4)
+  auto largest = [](const Bernstein2& p) {
+    double out = 0.0;
+    for (double c : p.coefficients) out = std::max(out, std::abs(c));
+    return out;
+  };
   // r_uu (m - 2, n) and r_vv (m, n - 2) vanish identically for m = 1 or n = 1; leaving the
   // product out then keeps the bidegree (6m - 4, 6n - 4) instead of padding it.
-  if (patch.degreeU < 2 || patch.degreeV < 2) return scale(mixedSquared, -1.0);
+  if (patch.degreeU < 2 || patch.degreeV < 2) {
+    return {scale(mixedSquared, -1.0), largest(mixed) * largest(mixed)};
+  }
   const Bernstein2 uu = dot(derivativesU(ru), normal);               // (3m - 3, 3n - 1)
   const Bernstein2 vv = dot(derivativesV(derivativesV(r)), normal);  // (3m - 1, 3n - 3)
-  return subtract(multiply(uu, vv), mixedSquared);                   // (6m - 4, 6n - 4)
+  return {subtract(multiply(uu, vv), mixedSquared),                  // (6m - 4, 6n - 4)
+          largest(uu) * largest(vv) + largest(mixed) * largest(mixed)};
+}
+
+}  // namespace
+
+Bernstein2 gaussianCurvatureNumerator(const BezierPatch& patch) {
+  return curvatureNumeratorAndBound(patch).first;
+}
+
+Bernstein2 normalLengthSquared(const BezierPatch& patch) {
+  const std::array<Bernstein2, 3> normal = normalPolynomials(patch);
+  return dot(normal, normal);
 }
 
 NormalDirection normalDirectionPolynomials(const BezierPatch& patch) {
@@ -283,34 +306,12 @@ NormalDirection normalDirectionPolynomials(const BezierPatch& patch) {
 }
 
 CurvatureSign curvatureSignPolynomial(const BezierPatch& patch) {
-  // As gaussianCurvatureNumerator, keeping the factors' sizes: a row or column of K's
-  // coefficients below 1e-12 of the terms' bound |r_uu . N| |r_vv . N| + |r_uv . N|^2 (their
-  // coefficients' largest magnitudes) vanishes but for rounding.
-  const std::array<Bernstein2, 3> r = coordinatePolynomials(patch);
-  const std::array<Bernstein2, 3> normal = normalPolynomials(patch);
-  const std::array<Bernstein2, 3> ru = derivativesU(r);
-  const Bernstein2 mixed = dot(derivativesV(ru), normal);
-  auto largest = [](const Bernstein2& p) {
-    double out = 0.0;
-    for (double c : p.coefficients) out = std::max(out, std::abs(c));
-    return out;
-  };
-  double termBound = largest(mixed) * largest(mixed);
-  Bernstein2 numerator = scale(multiply(mixed, mixed), -1.0);
-  if (patch.degreeU >= 2 && patch.degreeV >= 2) {
-    const Bernstein2 uu = dot(derivativesU(ru), normal);
-    const Bernstein2 vv = dot(derivativesV(derivativesV(r)), normal);
-    termBound += largest(uu) * largest(vv);
-    numerator = add(multiply(uu, vv), numerator);
-  }
+  // A row or column of K's coefficients below 1e-12 of the terms' bound vanishes but for
+  // rounding.
+  const auto [numerator, termBound] = curvatureNumeratorAndBound(patch);
   CurvatureSign out;
   out.polynomial = divideEdgeFactors({numerator}, 1e-12 * termBound, out.powers).front();
   return out;
-}
-
-Bernstein2 normalLengthSquared(const BezierPatch& patch) {
-  const std::array<Bernstein2, 3> normal = normalPolynomials(patch);
-  return dot(normal, normal);
 }
 
 PatchDerivatives derivativesToSecondOrder(const BezierPatch& patch, double u, double v) {

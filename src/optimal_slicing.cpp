@@ -1521,7 +1521,8 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
       // The polish's contacts missed a normal nearer to N* (a fold where the normal turns
       // fast, say): the claim falls, and what is proven at N* becomes the answer, found by
       // bisection on the certificate (the claim is an upper end; 0 holds trivially).
-      // kCertificateBisections halvings: to ~1e-9 of alpha*, a bounded cost.
+      // At most kCertificateBisections halvings, stopping at 1e-12 rad: a bounded cost (each
+      // certificate subdivides only about the contacts it cannot yet prove).
       result.uncertifiedAlphaRad = result.alphaRad;
       double proven = 0.0, refuted = result.certifiedAlphaRad;
       for (int step = 0; step < kCertificateBisections && refuted - proven > 1e-12; ++step) {
