@@ -423,6 +423,9 @@ struct NormalSampler {
 // ---------------------------------------------------------------------------------------
 
 constexpr double kRegularCellSpread = 0.5;  // radians
+// The pole cell's normals spread over at least this many tolerances (when some regular cell's
+// do): see the pole's choice in symmetrizedGaussMap.
+constexpr double kPoleCellSpreadTolerances = 8.0;
 
 // The coarse map of the band (see symmetrizedGaussMap): its tolerance (radians), used when
 // the tolerance asked for is at least kCoarseBandFactor times finer; the band's half-width
@@ -1270,6 +1273,19 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
     }
     builders.push_back(CellBuilder{data, tol, options.maxCellDepth, {}, nullptr, {}});
     inPatch(data, [&] { builders.back().run(); });
+    // A curved patch whose normals stay within the tolerance (its whole domain one small
+    // fold cell: no regular cell, nothing to trace; K of rounding size and both signs, as
+    // on a nearly flat patch) has an image below the tolerance: its boundary's normals stand
+    // for it, as for a developable patch. (Beside a plane, such a patch once left the map
+    // without a regular cell.)
+    const std::vector<Cell>& made = builders.back().cells;
+    const bool tiny = std::all_of(made.begin(), made.end(), [&](const Cell& c) {
+      return c.fold && c.traceAxis == 0 && c.spread <= tol;
+    });
+    if (tiny) {
+      builders.pop_back();
+      developablePatches.push_back(&data);
+    }
   }
   const bool allDevelopable = builders.empty();
 
@@ -1293,6 +1309,22 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
         const double area = (list[i].u1 - list[i].u0) * (list[i].v1 - list[i].v0);
         if (!list[i].fold && area > poleArea) poleBuilder = b, poleIndex = i, poleArea = area;
         if (list[i].traceAxis != 0 && area > tracedArea) tracedBuilder = b, tracedIndex = i, tracedArea = area;
+      }
+    }
+    // A cell whose image is not wide beside the tolerance cannot be the pole cell: its
+    // polygon, within the tolerance of a tiny curve, need not wind around its own centre
+    // normal, and then "outside its loop" is nearly the whole plane (a nearly flat patch
+    // beside a curved one made the whole map Omega, 6 of 600 random surfaces). The largest
+    // regular cell whose normals spread over at least kPoleCellSpreadTolerances
+    // tolerances wins, if there is one.
+    double wideArea = 0.0;
+    for (std::size_t b = 0; b < builders.size(); ++b) {
+      const std::vector<Cell>& list = builders[b].cells;
+      for (std::size_t i = 0; i < list.size(); ++i) {
+        const double area = (list[i].u1 - list[i].u0) * (list[i].v1 - list[i].v0);
+        if (!list[i].fold && list[i].spread >= kPoleCellSpreadTolerances * tol && area > wideArea) {
+          poleBuilder = b, poleIndex = i, wideArea = area;
+        }
       }
     }
     if (poleBuilder < builders.size() || tracedBuilder == builders.size()) break;

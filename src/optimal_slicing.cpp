@@ -1510,6 +1510,18 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
       result.alphaRad = std::acos(std::min(1.0, value));
       result.sphereCircle = {result.normal, result.alphaRad};
     }
+  } else if (result.method == "curve") {
+    // The curves' own optimum, polished on the true surface where that is better (a nearly
+    // flat curved patch among developable ones has normals off its boundary's curve, within
+    // the tolerance, that the curve search does not see).
+    double value = 0.0;
+    const Vec3 polished = polishDirection(ContactFinder(surface), result.normal, tol, value);
+    const double polishedAlpha = std::acos(std::min(1.0, value));
+    if (value > 0.0 && polishedAlpha > result.alphaRad) {
+      result.normal = polished;
+      result.alphaRad = polishedAlpha;
+      result.sphereCircle = {result.normal, result.alphaRad};
+    }
   }
   // Certificate: prove that no normal comes within alpha* less a small margin (what the
   // sampled-and-climbed maxima could have missed) of +-N*.

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "scallop/bezier.hpp"
+#include "scallop/error.hpp"
 #include "scallop/surface.hpp"
 #include "scallop/vector.hpp"
 
@@ -312,6 +313,44 @@ inline Surface twoPatchRegressionSurface() {
                           {0.5283, 1.0242, 0.4930, 0.2316, 1.0166, 0.2580, 0.6747},
                           {0.8372, 0.5874, 1.4148, 0.6583, 1.4150, 1.4974, 1.2883}};
   return twoPatchSurface(z);
+}
+
+// alpha(N) on the continuous surface, for a reference: the nearest of +-(the normals) to N,
+// from (grid + 1)^2 samples per patch, the best sample of each patch refined by a shrinking
+// pattern search in (u, v) (clamped to the patch). An upper estimate of the true alpha(N),
+// converged to a local minimum of the angle: samples can only miss nearer normals.
+inline double nearestNormalAngle(const Surface& s, const Vec3& direction, int grid = 200) {
+  const Vec3 m = normalized(direction);
+  double best = 10.0;
+  for (const BezierPatch& patch : s.patches) {
+    auto angleAt = [&](double u, double v) {
+      try {
+        return std::acos(std::min(1.0, std::abs(dot(unitNormal(patch, u, v), m))));
+      } catch (const Error&) {
+        return 10.0;  // a singular point: no normal (the limits are sampled beside it)
+      }
+    };
+    double bu = 0.0, bv = 0.0, local = 10.0;
+    for (int a = 0; a <= grid; ++a) {
+      for (int b = 0; b <= grid; ++b) {
+        const double value = angleAt(double(a) / grid, double(b) / grid);
+        if (value < local) local = value, bu = double(a) / grid, bv = double(b) / grid;
+      }
+    }
+    for (double step = 1.0 / grid; step > 1e-13;) {
+      bool improved = false;
+      for (int k = 0; k < 8; ++k) {
+        const double phi = std::numbers::pi * k / 4.0;
+        const double u = std::clamp(bu + step * std::cos(phi), 0.0, 1.0);
+        const double v = std::clamp(bv + step * std::sin(phi), 0.0, 1.0);
+        const double value = angleAt(u, v);
+        if (value < local) local = value, bu = u, bv = v, improved = true;
+      }
+      if (!improved) step *= 0.5;
+    }
+    best = std::min(best, local);
+  }
+  return best;
 }
 
 }  // namespace scallop::reference

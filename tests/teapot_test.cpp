@@ -39,44 +39,6 @@ Surface patchesOf(const Surface& whole, int first, int last) {
   return s;
 }
 
-// alpha(N) on the continuous surface, for a reference: the nearest of +-(the normals) to N,
-// from (grid + 1)^2 samples per patch, the best sample of each patch refined by a shrinking
-// pattern search in (u, v) (clamped to the patch). An upper estimate of the true alpha(N),
-// converged to a local minimum of the angle: samples can only miss nearer normals.
-double nearestNormalAngle(const Surface& s, const Vec3& direction, int grid = 200) {
-  const Vec3 m = normalized(direction);
-  double best = 10.0;
-  for (const BezierPatch& patch : s.patches) {
-    auto angleAt = [&](double u, double v) {
-      try {
-        return std::acos(std::min(1.0, std::abs(dot(unitNormal(patch, u, v), m))));
-      } catch (const Error&) {
-        return 10.0;  // a singular point: no normal (the limits are sampled beside it)
-      }
-    };
-    double bu = 0.0, bv = 0.0, local = 10.0;
-    for (int a = 0; a <= grid; ++a) {
-      for (int b = 0; b <= grid; ++b) {
-        const double value = angleAt(double(a) / grid, double(b) / grid);
-        if (value < local) local = value, bu = double(a) / grid, bv = double(b) / grid;
-      }
-    }
-    for (double step = 1.0 / grid; step > 1e-13;) {
-      bool improved = false;
-      for (int k = 0; k < 8; ++k) {
-        const double phi = std::numbers::pi * k / 4.0;
-        const double u = std::clamp(bu + step * std::cos(phi), 0.0, 1.0);
-        const double v = std::clamp(bv + step * std::sin(phi), 0.0, 1.0);
-        const double value = angleAt(u, v);
-        if (value < local) local = value, bu = u, bv = v, improved = true;
-      }
-      if (!improved) step *= 0.5;
-    }
-    best = std::min(best, local);
-  }
-  return best;
-}
-
 struct Case {
   std::string name;
   int first, last;
@@ -155,7 +117,7 @@ TEST(Teapot, ClosedGroupsClaimNothingUnproven) {
       // here: its sampling gap) is, on the continuous surface, no better than scallop's
       // answer beyond 0.01 degree.
       const reference::BruteForceSlicing bruteForce = reference::bruteForceOptimalAlpha(s);
-      EXPECT_LE(nearestNormalAngle(s, bruteForce.direction), result.alphaRad + 0.01 * kDeg);
+      EXPECT_LE(reference::nearestNormalAngle(s, bruteForce.direction), result.alphaRad + 0.01 * kDeg);
     }
   }
   // Which are proven today: all but the spout, whose (0, 1, 0) is a normal only on free
@@ -197,7 +159,7 @@ TEST(Teapot, SpoutLipAgainstDenseSamples) {
     const double atOptimum = reference::sampledAlpha(dense, result.normal);
     EXPECT_GE(atOptimum, result.alphaRad - 1e-12);
     // The nearest normal to +-N* on the continuous patch (an upper estimate still, converged).
-    const double best = nearestNormalAngle(s, result.normal, 400);
+    const double best = reference::nearestNormalAngle(s, result.normal, 400);
     EXPECT_GE(best, result.alphaRad - 1e-12);
     EXPECT_LE(best, result.alphaRad + 1e-4 * kDeg);
     const reference::BruteForceSlicing bruteForce = reference::bruteForceOptimalAlpha(s);
@@ -241,8 +203,8 @@ TEST(Teapot, RandomSurfacesOfRevolutionMatchBruteForce) {
     // scallop's certified angle is no more than the surface allows at N* (the nearest normal
     // found independently), and to within 0.01 degree what it allows there; and the brute
     // force's best direction, measured the same way, is no better beyond 0.01 degree.
-    const double atOptimum = nearestNormalAngle(s, result.normal);
-    const double atBruteForce = nearestNormalAngle(s, bruteForce.direction);
+    const double atOptimum = reference::nearestNormalAngle(s, result.normal);
+    const double atBruteForce = reference::nearestNormalAngle(s, bruteForce.direction);
     EXPECT_LE(result.alphaRad, atOptimum + 1e-12);
     EXPECT_GE(result.alphaRad, atOptimum - 0.01 * kDeg);
     EXPECT_LE(atBruteForce, result.alphaRad + 0.01 * kDeg)
