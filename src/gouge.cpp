@@ -836,8 +836,9 @@ GougeReport gougeCheck(const SurfaceDistance& distance, const ToolPath& path, do
         report.deepest = {s.pass, s.move, s.onLink, center, contact};
       }
       if (s.sampleStart && contact.distance > report.tolerance) {
-        // Material side: opposite the upward normal at the closest point (see the contract).
-        Vec3 up = normalVector(distance.surface().patches[contact.patch], contact.u, contact.v);
+        // Material side: opposite the upward normal at the closest point (see the contract);
+        // unitNormal's limit on an apex row, where r_u x r_v itself vanishes.
+        Vec3 up = unitNormal(distance.surface().patches[contact.patch], contact.u, contact.v);
         if (up.z < 0.0) up = -up;
         if (up.z > 0.0 && dot(center - contact.point, up) < 0.0) ++report.passStartsBelowSurface;
       }
