@@ -466,6 +466,10 @@ struct Cell {
   // Fold cells whose parabolic line is traced (see traceAxis): 1 when K's zero set is a
   // graph v(u) on the cell, 2 when it is a graph u(v); 0 for the small fold cells.
   int traceAxis = 0;
+  // Regular cells: the least angle from the centre normal to the normals at the cell's
+  // corners and edge midpoints, about the radius of the widest disk about the centre inside
+  // the image (a thin image, from a nearly developable patch, has it far below its spread).
+  double innerRadius = 0.0;
 };
 
 // Whether the parabolic line crosses the cell (K's Bernstein coefficients `k` over it) as a
@@ -565,7 +569,13 @@ struct CellBuilder {
       for (int j = 0; j <= 2; ++j) spread = std::max(spread, angleBetween(centre, grid[i][j]));
     }
     if (strictSign(k) && spread <= kRegularCellSpread) {
-      cells.push_back({u0, u1, v0, v1, false, centre, spread, bounds(k).lo > 0.0 ? 1 : -1});
+      double inner = spread;
+      for (int i = 0; i <= 2; ++i) {
+        for (int j = 0; j <= 2; ++j) {
+          if (i != 1 || j != 1) inner = std::min(inner, angleBetween(centre, grid[i][j]));
+        }
+      }
+      cells.push_back({u0, u1, v0, v1, false, centre, spread, bounds(k).lo > 0.0 ? 1 : -1, 0, inner});
       return;
     }
     if (spread <= kRegularCellSpread) {
@@ -1278,9 +1288,12 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
     // on a nearly flat patch) has an image below the tolerance: its boundary's normals stand
     // for it, as for a developable patch. (Beside a plane, such a patch once left the map
     // without a regular cell.)
+    // Likewise a patch whose image is thinner than the tolerance everywhere (a nearly
+    // developable patch: its regular cells' images all narrower than a quarter tolerance):
+    // the strips of half-width tol / 2 about its boundary's images hold it.
     const std::vector<Cell>& made = builders.back().cells;
     const bool tiny = std::all_of(made.begin(), made.end(), [&](const Cell& c) {
-      return c.fold && c.traceAxis == 0 && c.spread <= tol;
+      return c.traceAxis == 0 && (c.fold ? c.spread <= tol : c.innerRadius < 0.25 * tol);
     });
     if (tiny) {
       builders.pop_back();
@@ -1312,17 +1325,18 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
       }
     }
     // A cell whose image is not wide beside the tolerance cannot be the pole cell: its
-    // polygon, within the tolerance of a tiny curve, need not wind around its own centre
+    // polygon, within the tolerance of its curves, need not wind around its own centre
     // normal, and then "outside its loop" is nearly the whole plane (a nearly flat patch
     // beside a curved one made the whole map Omega, 6 of 600 random surfaces). The largest
-    // regular cell whose normals spread over at least kPoleCellSpreadTolerances
-    // tolerances wins, if there is one.
+    // regular cell whose image holds a disk of kPoleCellSpreadTolerances / 4 tolerances
+    // about its centre normal (see Cell::innerRadius) wins, if there is one.
     double wideArea = 0.0;
     for (std::size_t b = 0; b < builders.size(); ++b) {
       const std::vector<Cell>& list = builders[b].cells;
       for (std::size_t i = 0; i < list.size(); ++i) {
         const double area = (list[i].u1 - list[i].u0) * (list[i].v1 - list[i].v0);
-        if (!list[i].fold && list[i].spread >= kPoleCellSpreadTolerances * tol && area > wideArea) {
+        if (!list[i].fold && list[i].innerRadius >= 0.25 * kPoleCellSpreadTolerances * tol &&
+            area > wideArea) {
           poleBuilder = b, poleIndex = i, wideArea = area;
         }
       }

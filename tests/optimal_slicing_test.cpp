@@ -847,6 +847,12 @@ TEST(OptimalSlicing, MixedMultiPatchSurfacesAlwaysGiveCertifiedAnswers) {
     // find it, not call the complement empty.
     EXPECT_NE(result.method, "lattice");
     EXPECT_NE(result.method, "covered");
+    if (trial % 16 == 0) {
+      // Every 16th against the brute force's best direction on the continuous surface.
+      const scallop::reference::BruteForceSlicing bruteForce = scallop::reference::bruteForceOptimalAlpha(s);
+      EXPECT_LE(scallop::reference::nearestNormalAngle(s, bruteForce.direction), result.alphaRad + 0.01 * kDeg)
+          << result.method;
+    }
     ++answered;
   }
   EXPECT_GT(answered, 380);
