@@ -32,6 +32,12 @@ void validateSelection(const Surface& selected, const std::vector<std::size_t>& 
   }
 }
 
+// The file name ("<stdin>" for "-") or "example NAME", without the patch selection.
+std::string sourceBaseName(const SurfaceSource& source) {
+  if (!source.example.empty()) return "example " + source.example;
+  return source.input == "-" ? std::string("<stdin>") : source.input;
+}
+
 }  // namespace
 
 void addSurfaceSourceOptions(CLI::App& command, SurfaceSource& source, const std::string& fileHelp,
@@ -59,9 +65,7 @@ Surface loadSurface(const SurfaceSource& source) {
   if (source.patches.empty()) {
     return source.example.empty() ? readSurface(source.input) : exampleSurface(source.example);
   }
-  const std::string name = source.example.empty()
-                               ? (source.input == "-" ? std::string("<stdin>") : source.input)
-                               : "example " + source.example;
+  const std::string name = sourceBaseName(source);
   // Examples are built, not read: they are not validated (as without --patches).
   const Surface whole = source.example.empty() ? readSurface(source.input, SurfaceCheck::formOnly)
                                                : exampleSurface(source.example);
@@ -77,9 +81,7 @@ Surface loadSurface(const SurfaceSource& source) {
 }
 
 std::string sourceName(const SurfaceSource& source) {
-  std::string name = !source.example.empty() ? "example " + source.example
-                     : source.input == "-"   ? std::string("<stdin>")
-                                             : source.input;
+  std::string name = sourceBaseName(source);
   if (!source.patches.empty()) name += fmt::format(" (patches {})", source.patches);
   return name;
 }

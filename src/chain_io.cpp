@@ -1,5 +1,6 @@
 #include "examples.hpp"
 #include "input_file.hpp"
+#include "text_input.hpp"
 #include "scallop/chain_io.hpp"
 
 #include <algorithm>
@@ -22,22 +23,15 @@
 namespace scallop {
 namespace {
 
+using detail::clipped;
+using detail::displayName;
+using detail::isBlank;
+using detail::trim;
+
 // ---------------------------------------------------------------------------------------
 // Shared helpers
 // ---------------------------------------------------------------------------------------
 
-constexpr std::size_t kMaxQuotedLength = 60;
-
-// Error messages quote the offending text; a runaway line (a binary file, say) is cut.
-std::string clipped(std::string_view text) {
-  if (text.size() <= kMaxQuotedLength) return std::string(text);
-  return std::string(text.substr(0, kMaxQuotedLength)) + "...";
-}
-
-// How a source is named in messages: "-" is standard input.
-std::string displayName(const std::string& sourceName) {
-  return sourceName == "-" ? std::string("<stdin>") : sourceName;
-}
 
 // validateChain is the authority on the chain invariant; the parsers check the same
 // conditions first so that they can name the line or point, and this catches anything a
@@ -54,13 +48,6 @@ void validateParsedChain(const Chain& chain, const std::string& source) {
 // Text format
 // ---------------------------------------------------------------------------------------
 
-bool isSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
-
-std::string_view trim(std::string_view text) {
-  while (!text.empty() && isSpace(text.front())) text.remove_prefix(1);
-  while (!text.empty() && isSpace(text.back())) text.remove_suffix(1);
-  return text;
-}
 
 // The line without its comment and surrounding blanks.
 std::string_view stripComment(std::string_view line) {
@@ -82,14 +69,14 @@ std::vector<std::string_view> splitFields(std::string_view line, const std::stri
   std::size_t i = 0;
   while (true) {
     const std::size_t start = i;
-    while (i < line.size() && !isSpace(line[i]) && line[i] != ',') ++i;
+    while (i < line.size() && !isBlank(line[i]) && line[i] != ',') ++i;
     if (i == start) throwAtLine(source, lineNumber, "empty field (stray comma) in", line);
     fields.push_back(line.substr(start, i - start));
     if (i == line.size()) return fields;
-    while (i < line.size() && isSpace(line[i])) ++i;
+    while (i < line.size() && isBlank(line[i])) ++i;
     if (line[i] == ',') {
       ++i;
-      while (i < line.size() && isSpace(line[i])) ++i;
+      while (i < line.size() && isBlank(line[i])) ++i;
       if (i == line.size()) throwAtLine(source, lineNumber, "empty field (stray comma) in", line);
     }
   }

@@ -1,5 +1,6 @@
 #include "examples.hpp"
 #include "teapot.hpp"
+#include "text_input.hpp"
 #include "scallop/surface.hpp"
 
 #include <algorithm>
@@ -25,24 +26,17 @@
 namespace scallop {
 namespace {
 
+using detail::displayName;
+
 using Json = nlohmann::json;
 
 // ---------------------------------------------------------------------------------------
 // Messages
 // ---------------------------------------------------------------------------------------
 
-constexpr std::size_t kMaxQuotedLength = 60;
-
 // Error messages quote the offending JSON value; a huge one is cut.
-std::string quoted(const Json& value) {
-  std::string text = value.dump();
-  if (text.size() > kMaxQuotedLength) text = text.substr(0, kMaxQuotedLength) + "...";
-  return text;
-}
+std::string quoted(const Json& value) { return detail::clipped(value.dump()); }
 
-std::string displayName(const std::string& sourceName) {
-  return sourceName == "-" ? std::string("<stdin>") : sourceName;
-}
 
 // nlohmann's messages start with "[json.exception.parse_error.101] "; the rest (line,
 // column, what was expected) is what a user needs.

@@ -1,4 +1,5 @@
 #include "input_file.hpp"
+#include "text_input.hpp"
 #include "scallop/surface_io.hpp"
 
 #include <algorithm>
@@ -18,26 +19,13 @@
 namespace scallop {
 namespace {
 
-constexpr std::size_t kMaxQuotedLength = 60;
+using detail::clipped;
+using detail::displayName;
+using detail::isBlank;
+using detail::trim;
+
 constexpr std::string_view kByteOrderMark = "\xEF\xBB\xBF";
 
-// Error messages quote the offending text; a runaway line (a binary file, say) is cut.
-std::string clipped(std::string_view text) {
-  if (text.size() <= kMaxQuotedLength) return std::string(text);
-  return std::string(text.substr(0, kMaxQuotedLength)) + "...";
-}
-
-std::string displayName(const std::string& sourceName) {
-  return sourceName == "-" ? std::string("<stdin>") : sourceName;
-}
-
-bool isBlank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
-
-std::string_view trim(std::string_view text) {
-  while (!text.empty() && isBlank(text.front())) text.remove_prefix(1);
-  while (!text.empty() && isBlank(text.back())) text.remove_suffix(1);
-  return text;
-}
 
 std::vector<std::string_view> splitFields(std::string_view line) {
   std::vector<std::string_view> fields;
