@@ -111,57 +111,9 @@ void BM_BruteForceEnvelope(benchmark::State& state) {
 //   BM_OrientCertificate/<surface>    the Bernstein-form certificate at N*, alpha* - 1e-7
 constexpr double kDegree = 3.14159265358979323846 / 180.0;
 
-void BM_Orient(benchmark::State& state, const char* name) {
-  const scallop::Surface surface = scallop::exampleSurface(name);
-  for (auto _ : state) {
-    scallop::OptimalSlicing result = scallop::optimalSlicing(surface);
-    benchmark::DoNotOptimize(result.alphaRad);
-  }
-}
-
-// The same with the lattice's 2,000 seeds (OptimalSlicingOptions::latticeSeeds), as before
-// they became an option: what the safety net costs.
-void BM_OrientWithLatticeSeeds(benchmark::State& state, const char* name) {
-  const scallop::Surface surface = scallop::exampleSurface(name);
-  scallop::OptimalSlicingOptions options;
-  options.latticeSeeds = true;
-  for (auto _ : state) {
-    scallop::OptimalSlicing result = scallop::optimalSlicing(surface, options);
-    benchmark::DoNotOptimize(result.alphaRad);
-  }
-}
-
-// The Utah teapot at the default tolerance (issue targets: each patch <= 50 ms, the whole
-// <= 1 s): BM_OrientTeapotPatch/<i> one patch, BM_OrientTeapot/<part> a built-in part or the
-// whole (the closed parts end in the covering proof, or the lattice's polish without one).
-void BM_OrientTeapotPatch(benchmark::State& state) {
-  const scallop::Surface whole = scallop::exampleSurface("teapot");
-  scallop::Surface surface{whole.units, {whole.patches[static_cast<std::size_t>(state.range(0))]}};
-  scallop::OptimalSlicing result;
-  for (auto _ : state) {
-    result = scallop::optimalSlicing(surface);
-    double alpha = result.alphaRad;  // a copy: see BM_OrientFine
-    benchmark::DoNotOptimize(alpha);
-  }
-  state.counters["alpha_deg"] = result.alphaRad / kDegree;
-}
-
-void BM_OrientTeapot(benchmark::State& state, const char* name) {
-  const scallop::Surface surface = scallop::exampleSurface(name);
-  scallop::OptimalSlicing result;
-  for (auto _ : state) {
-    result = scallop::optimalSlicing(surface);
-    double alpha = result.alphaRad;  // a copy: see BM_OrientFine
-    benchmark::DoNotOptimize(alpha);
-  }
-  state.counters["alpha_deg"] = result.alphaRad / kDegree;
-  state.counters["covered"] = result.method == "covered" ? 1.0 : 0.0;
-}
-
-void BM_OrientFine(benchmark::State& state, const char* name, double toleranceDeg) {
-  const scallop::Surface surface = scallop::exampleSurface(name);
-  scallop::OptimalSlicingOptions options;
-  options.toleranceRad = toleranceDeg * kDegree;
+// The timed loop of the orient benchmarks; the last result, for counters.
+scallop::OptimalSlicing timeOrient(benchmark::State& state, const scallop::Surface& surface,
+                                   const scallop::OptimalSlicingOptions& options = {}) {
   scallop::OptimalSlicing result;
   for (auto _ : state) {
     result = scallop::optimalSlicing(surface, options);
@@ -170,6 +122,42 @@ void BM_OrientFine(benchmark::State& state, const char* name, double toleranceDe
     double alpha = result.alphaRad;
     benchmark::DoNotOptimize(alpha);
   }
+  return result;
+}
+
+void BM_Orient(benchmark::State& state, const char* name) {
+  timeOrient(state, scallop::exampleSurface(name));
+}
+
+// The same with the lattice's 2,000 seeds (OptimalSlicingOptions::latticeSeeds), as before
+// they became an option: what the safety net costs.
+void BM_OrientWithLatticeSeeds(benchmark::State& state, const char* name) {
+  scallop::OptimalSlicingOptions options;
+  options.latticeSeeds = true;
+  timeOrient(state, scallop::exampleSurface(name), options);
+}
+
+// The Utah teapot at the default tolerance (issue targets: each patch <= 50 ms, the whole
+// <= 1 s): BM_OrientTeapotPatch/<i> one patch, BM_OrientTeapot/<part> a built-in part or the
+// whole (the closed parts end in the covering proof, or the lattice's polish without one).
+void BM_OrientTeapotPatch(benchmark::State& state) {
+  const scallop::Surface whole = scallop::exampleSurface("teapot");
+  const scallop::Surface surface{whole.units, {whole.patches[static_cast<std::size_t>(state.range(0))]}};
+  const scallop::OptimalSlicing result = timeOrient(state, surface);
+  state.counters["alpha_deg"] = result.alphaRad / kDegree;
+}
+
+void BM_OrientTeapot(benchmark::State& state, const char* name) {
+  const scallop::OptimalSlicing result = timeOrient(state, scallop::exampleSurface(name));
+  state.counters["alpha_deg"] = result.alphaRad / kDegree;
+  state.counters["covered"] = result.method == "covered" ? 1.0 : 0.0;
+}
+
+void BM_OrientFine(benchmark::State& state, const char* name, double toleranceDeg) {
+  const scallop::Surface surface = scallop::exampleSurface(name);
+  scallop::OptimalSlicingOptions options;
+  options.toleranceRad = toleranceDeg * kDegree;
+  const scallop::OptimalSlicing result = timeOrient(state, surface, options);
   state.counters["segments"] = static_cast<double>(result.gaussMap.boundarySegments);
   state.counters["alpha_deg"] = result.alphaRad / kDegree;
 }
@@ -178,10 +166,7 @@ void BM_OrientNoCertificate(benchmark::State& state, const char* name) {
   const scallop::Surface surface = scallop::exampleSurface(name);
   scallop::OptimalSlicingOptions options;
   options.certify = false;
-  for (auto _ : state) {
-    scallop::OptimalSlicing result = scallop::optimalSlicing(surface, options);
-    benchmark::DoNotOptimize(result.alphaRad);
-  }
+  timeOrient(state, surface, options);
 }
 
 void BM_OrientCertificate(benchmark::State& state, const char* name) {
