@@ -107,6 +107,7 @@ void BM_BruteForceEnvelope(benchmark::State& state) {
 // BM_OrientNoCertificate less BM_GaussMap less BM_OrientMedialAxis):
 //   BM_GaussMap/<surface>             the symmetrized Gauss map
 //   BM_OrientMedialAxis/<surface>     the medial axis of its projected complement
+//   BM_OrientSingularCorners/<k>  paper-1 with k corners where r_u x r_v vanishes
 //   BM_OrientNoCertificate/<surface>  the pipeline without the certificate
 //   BM_OrientCertificate/<surface>    the Bernstein-form certificate at N*, alpha* - 1e-7
 constexpr double kDegree = 3.14159265358979323846 / 180.0;
@@ -151,6 +152,19 @@ void BM_OrientTeapot(benchmark::State& state, const char* name) {
   const scallop::OptimalSlicing result = timeOrient(state, scallop::exampleSurface(name));
   state.counters["alpha_deg"] = result.alphaRad / kDegree;
   state.counters["covered"] = result.method == "covered" ? 1.0 : 0.0;
+}
+
+// Paper-1's patch with corners made singular (p01 = p00 at (0, 0); with range 2 also
+// p32 = p33 at (1, 1): quartered): what the fans of surface.hpp's cornerPieces cost beside
+// BM_Orient/paper1.
+void BM_OrientSingularCorners(benchmark::State& state) {
+  scallop::Surface surface = scallop::exampleSurface("paper-1");
+  scallop::BezierPatch& patch = surface.patches[0];
+  patch.control[1] = patch.control[0];
+  if (state.range(0) == 2) patch.control[14] = patch.control[15];
+  const scallop::OptimalSlicing result = timeOrient(state, surface);
+  state.counters["alpha_deg"] = result.alphaRad / kDegree;
+  state.counters["pieces"] = static_cast<double>(scallop::cornerPieces(patch).size());
 }
 
 void BM_OrientFine(benchmark::State& state, const char* name, double toleranceDeg) {
@@ -266,6 +280,7 @@ BENCHMARK_CAPTURE(BM_Orient, paper1, "paper-1")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Orient, paper2, "paper-2")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_OrientWithLatticeSeeds, paper1, "paper-1")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_OrientWithLatticeSeeds, paper2, "paper-2")->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_OrientSingularCorners)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_OrientTeapotPatch)->DenseRange(0, 31)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_OrientTeapot, rim, "teapot-rim")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_OrientTeapot, body, "teapot-body")->Unit(benchmark::kMillisecond);

@@ -195,6 +195,12 @@ double normalRoundingThreshold(const BezierPatch& patch) {
   return (6.0 * (m + n) + 8.0) * kUnitRoundoff * (m * su) * (n * sv);
 }
 
+namespace {
+// How far from a corner unitNormal takes the ray limit where q is below rounding: q's zero at
+// the corner is simple, so |q| ~ |q_u| |(du, dv)| exceeds the threshold well inside this.
+constexpr double kCornerRayRadius = 1e-6;
+}  // namespace
+
 Vec3 unitNormal(const BezierPatch& patch, double u, double v) {
   requireValid(patch, "unitNormal");
   const Vec3 normal = cross(partial(patch, u, v, 1, 0), partial(patch, u, v, 0, 1));
@@ -205,12 +211,29 @@ Vec3 unitNormal(const BezierPatch& patch, double u, double v) {
   // direction field N = u^a (1 - u)^b v^c (1 - v)^d q (normalDirectionPolynomials): rare
   // points, so the Bernstein forms are built here rather than kept.
   const NormalDirection direction = normalDirectionPolynomials(patch);
+  const std::array<Bernstein2, 3>& q = direction.polynomials;
+  const double cu = std::clamp(u, 0.0, 1.0), cv = std::clamp(v, 0.0, 1.0);
   if (direction.powers.any()) {
-    const double cu = std::clamp(u, 0.0, 1.0), cv = std::clamp(v, 0.0, 1.0);
-    const Vec3 q{evaluate(direction.polynomials[0], cu, cv), evaluate(direction.polynomials[1], cu, cv),
-                 evaluate(direction.polynomials[2], cu, cv)};
-    const double qLength = norm(q);
-    if (qLength > threshold) return q / qLength;
+    const Vec3 value{evaluate(q[0], cu, cv), evaluate(q[1], cu, cv), evaluate(q[2], cu, cv)};
+    const double qLength = norm(value);
+    if (qLength > threshold) return value / qLength;
+  }
+  // Within rounding of a corner where q itself vanishes (surface.hpp's cornerPieces: q =
+  // du q_u + dv q_v + O(|(du, dv)|^2) there): the limit along the ray from the corner
+  // through (u, v), at the corner itself along the diagonal into the patch.
+  const double u0 = cu < 0.5 ? 0.0 : 1.0, v0 = cv < 0.5 ? 0.0 : 1.0;
+  if (std::hypot(cu - u0, cv - v0) <= kCornerRayRadius) {
+    double du = cu - u0, dv = cv - v0;
+    if (du == 0.0 && dv == 0.0) du = 1.0 - 2.0 * u0, dv = 1.0 - 2.0 * v0;
+    const double rayScale = std::hypot(du, dv);
+    du /= rayScale, dv /= rayScale;
+    Vec3 ray;
+    for (std::size_t c = 0; c < 3; ++c) {
+      const double slope = du * evaluate(derivativeU(q[c]), u0, v0) + dv * evaluate(derivativeV(q[c]), u0, v0);
+      (c == 0 ? ray.x : c == 1 ? ray.y : ray.z) = slope;
+    }
+    const double rayLength = norm(ray);
+    if (rayLength > threshold) return ray / rayLength;
   }
   throw Error(fmt::format(
       "unitNormal: r_u x r_v vanishes at (u, v) = ({}, {}); the patch is not regular there", u, v));

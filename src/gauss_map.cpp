@@ -175,7 +175,11 @@ bool hasNormal(const std::array<Bernstein2, 3>& normal, const Vec3& m) {
       v -= dv;
       if (!(u >= lo0 && u <= hi0 && v >= lo1 && v <= hi1)) return false;
       if (std::abs(du) + std::abs(dv) < 1e-13) {
-        return u >= 0.0 && u <= 1.0 && v >= 0.0 && v <= 1.0 && evaluate(g, u, v) > 0.0;
+        // A root on the patch's edge may converge a rounding error outside it; the test's
+        // resolution (the contract's 1e-10 in parameter) admits it.
+        const double slack = 1e-10;
+        return u >= -slack && u <= 1.0 + slack && v >= -slack && v <= 1.0 + slack &&
+               evaluate(g, u, v) > 0.0;
       }
     }
     return false;
@@ -1222,7 +1226,7 @@ IntLoops mergeSheet(const IntLoops& cells) {
 
 bool isSymmetrizedNormal(const Surface& surface, const Vec3& direction) {
   std::vector<PatchData> patches;
-  for (const BezierPatch& p : surface.patches) patches.push_back(makePatchData(p));
+  for (const BezierPatch& p : cornerResolved(surface).patches) patches.push_back(makePatchData(p));
   return inOmega(patches, normalized(direction));
 }
 
@@ -1244,9 +1248,13 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
   if (surface.patches.empty()) throw Error("the surface has no patches");
   GaussMap map;
   std::vector<PatchData> patches;
-  for (const BezierPatch& p : surface.patches) {
-    patches.push_back(makePatchData(p));
-    patches.back().index = patches.size() - 1;
+  // Corners where q vanishes are blown up into fans (surface.hpp's cornerPieces): their ray
+  // limits become an apex row's curve, a boundary like any other.
+  std::vector<std::size_t> sources;
+  const Surface resolved = cornerResolved(surface, &sources);
+  for (std::size_t i = 0; i < resolved.patches.size(); ++i) {
+    patches.push_back(makePatchData(resolved.patches[i]));
+    patches.back().index = sources[i];
   }
   // Errors from one patch's quadtree or sampling name the patch.
   auto inPatch = [](const PatchData& data, const auto& work) {

@@ -1048,7 +1048,8 @@ NormalCoverage proveNormalsCoverSphere(const Surface& surface,
       }
     }
   }
-  return Prover(surface, options).run();
+  // Corners where q vanishes as fans (surface.hpp's cornerPieces), their apex rows glued.
+  return Prover(cornerResolved(surface), options).run();
 }
 
 }  // namespace scallop

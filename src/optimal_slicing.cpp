@@ -1306,7 +1306,7 @@ bool certifyClearance(const Surface& surface, const Vec3& n, double lowerBoundRa
   if (!(lowerBoundRad > 0.0)) return true;
   const Vec3 m = normalized(n);
   const double c = std::cos(lowerBoundRad);
-  for (const BezierPatch& patch : surface.patches) {
+  for (const BezierPatch& patch : cornerResolved(surface).patches) {
     // q, N's direction field (collapsed edges factored out), for N: the same directions, and
     // on an apex row their limits, which the certificate must cover too.
     const std::array<Bernstein2, 3> normal = normalDirectionPolynomials(patch).polynomials;
@@ -1379,6 +1379,9 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
                             0.1 * 180.0 / std::numbers::pi, tol * 180.0 / std::numbers::pi));
   }
   validateSurface(surface);
+  // The polish climbs on pieces without corners where q vanishes (its heights divide by
+  // |q|); the Gauss map, the coverage proof and the certificate resolve them themselves.
+  const Surface working = cornerResolved(surface);
   OptimalSlicing result;
   GaussMapOptions gaussOptions;
   gaussOptions.toleranceRad = tol;
@@ -1490,7 +1493,7 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
     // few tolerances, and each polish is cheap (a few Newton steps). With the option, then
     // the lattice's seeds (see latticeSeeds); the medial axis's rivals come first and win
     // ties.
-    const ContactFinder finder(surface);
+    const ContactFinder finder(working);
     if (options.latticeSeeds || result.method == "lattice") {
       for (const Vec3& seed : finder.latticeSeeds(2000, 4, 2.0 * std::numbers::pi / 180.0)) rivals.push_back(seed);
     }
@@ -1504,7 +1507,7 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
     result.sphereCircle = {result.normal, result.alphaRad};
   } else if (result.method == "plane") {
     double value = 0.0;
-    const Vec3 polished = polishDirection(ContactFinder(surface), result.normal, tol, value);
+    const Vec3 polished = polishDirection(ContactFinder(working), result.normal, tol, value);
     if (value > 0.0) {
       result.normal = polished;
       result.alphaRad = std::acos(std::min(1.0, value));
@@ -1515,7 +1518,7 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
     // flat curved patch among developable ones has normals off its boundary's curve, within
     // the tolerance, that the curve search does not see).
     double value = 0.0;
-    const Vec3 polished = polishDirection(ContactFinder(surface), result.normal, tol, value);
+    const Vec3 polished = polishDirection(ContactFinder(working), result.normal, tol, value);
     const double polishedAlpha = std::acos(std::min(1.0, value));
     if (value > 0.0 && polishedAlpha > result.alphaRad) {
       result.normal = polished;

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -66,7 +67,6 @@ std::string shortest(double value) {
 // Regularity: f = |r_u x r_v|^2 in Bernstein form, quadtree
 // ---------------------------------------------------------------------------------------
 
-constexpr double kRelativeNormalTolerance = 1e-12;  // tau = 1e-12 scale^2
 constexpr double kUnitRoundoff = std::numeric_limits<double>::epsilon() / 2.0;
 
 // Rounding allowances of the two certificates after `depth` quadtree levels, from the error
@@ -185,20 +185,27 @@ double normalLengthAt(const BezierPatch& patch, double u, double v) {
 
 }  // namespace
 
-PatchRegularity checkPatchRegularity(const BezierPatch& original) {
-  const bool shaped = original.degreeU >= 1 && original.degreeV >= 1 &&
-                      original.control.size() == static_cast<std::size_t>(original.degreeU + 1) *
-                                                     static_cast<std::size_t>(original.degreeV + 1);
+namespace {
+
+// Degrees >= 1 and (m + 1)(n + 1) finite control points, or scallop::Error from `what`.
+void requireWellFormed(const BezierPatch& patch, const char* what) {
+  const bool shaped = patch.degreeU >= 1 && patch.degreeV >= 1 &&
+                      patch.control.size() == static_cast<std::size_t>(patch.degreeU + 1) *
+                                                  static_cast<std::size_t>(patch.degreeV + 1);
   const bool finite = std::all_of(
-      original.control.begin(), original.control.end(),
+      patch.control.begin(), patch.control.end(),
       [](const Vec3& p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z); });
   if (!shaped || !finite) {
     throw Error(fmt::format(
-        "checkPatchRegularity: expected degrees >= 1, (m + 1)(n + 1) finite control points; got "
-        "degree [{}, {}] with {} points{}",
-        original.degreeU, original.degreeV, original.control.size(),
-        finite ? "" : ", not all finite"));
+        "{}: expected degrees >= 1, (m + 1)(n + 1) finite control points; got degree [{}, {}] "
+        "with {} points{}",
+        what, patch.degreeU, patch.degreeV, patch.control.size(), finite ? "" : ", not all finite"));
   }
+}
+
+// The regularity check proper (the contract's quadtree), on a patch whose corners are not
+// singular, or that is itself a corner piece.
+PatchRegularity checkPieceRegularity(const BezierPatch& original) {
   // Work on the patch scaled by a power of two (exact, barring underflow of coordinates
   // far below the largest) so that its largest |coordinate| lies in [0.5, 1): the squares
   // and fourth powers below can then neither overflow nor underflow, and the verdict is
@@ -286,6 +293,234 @@ PatchRegularity checkPatchRegularity(const BezierPatch& original) {
   return result;
 }
 
+}  // namespace
+
+// ---------------------------------------------------------------------------------------
+// Singular corners: pieces whose normals have limits
+// ---------------------------------------------------------------------------------------
+
+namespace {
+
+// Corner c of [0, 1]^2: bit 0 set for u = 1, bit 1 set for v = 1.
+double cornerU(int corner) { return (corner & 1) ? 1.0 : 0.0; }
+double cornerV(int corner) { return (corner & 2) ? 1.0 : 0.0; }
+
+// The corners where q (N with collapsed edges' factors divided out) is within tau =
+// kRelativeNormalTolerance scale^2 of 0, as bits 1 << corner. Decided on the patch scaled by
+// a power of two (exact), as the regularity check: no overflow, the same verdict.
+unsigned singularCorners(const BezierPatch& original) {
+  int exponent = 0;
+  std::frexp(patchScale(original), &exponent);
+  BezierPatch patch = original;
+  for (Vec3& p : patch.control) {
+    p = {std::ldexp(p.x, -exponent), std::ldexp(p.y, -exponent), std::ldexp(p.z, -exponent)};
+  }
+  const double scale = patchScale(patch);
+  const double tau = kRelativeNormalTolerance * scale * scale;
+  const std::array<Bernstein2, 3>& q = normalDirectionPolynomials(patch).polynomials;
+  auto length = [&](int i, int j) { return norm(Vec3{q[0].at(i, j), q[1].at(i, j), q[2].at(i, j)}); };
+  unsigned corners = 0;
+  for (int corner = 0; corner < 4; ++corner) {
+    // A Bernstein form's corner coefficient is its value there, exactly; its neighbours
+    // along the two edges are that value plus q_u / m', q_v / n': above tau when the zero is
+    // of first order along the edges (a row nearly collapsed, q within tau along it, is
+    // left to the quadtree, which rejects it).
+    if (q[0].degreeU < 1 || q[0].degreeV < 1) break;  // q constant along an edge: no such zero
+    const int i = (corner & 1) ? q[0].degreeU : 0;
+    const int j = (corner & 2) ? q[0].degreeV : 0;
+    const int inwardI = (corner & 1) ? i - 1 : i + 1;
+    const int inwardJ = (corner & 2) ? j - 1 : j + 1;
+    if (length(i, j) <= tau && length(inwardI, j) > tau && length(i, inwardJ) > tau) {
+      corners |= 1u << corner;
+    }
+  }
+  return corners;
+}
+
+Bernstein2 transposed(const Bernstein2& p) {
+  Bernstein2 t{p.degreeV, p.degreeU, std::vector<double>(p.coefficients.size())};
+  for (int i = 0; i <= p.degreeU; ++i) {
+    for (int j = 0; j <= p.degreeV; ++j) t.coefficients[j * (p.degreeU + 1) + i] = p.at(i, j);
+  }
+  return t;
+}
+
+// p(a, phi(a, t)) for p of bidegree (m, n) and phi of bidegree (1, 1): bidegree (m + n, n) in
+// (a, t). De Casteljau in v, its weights 1 - phi and phi being polynomials in (a, t): each
+// of the n levels raises the bidegree by (1, 1); the rows are then summed with b_j^m(a).
+Bernstein2 composedInV(const Bernstein2& p, const Bernstein2& phi) {
+  const int m = p.degreeU;
+  const int n = p.degreeV;
+  const Bernstein2 one{0, 0, {1.0}};
+  const Bernstein2 complement = subtract(one, phi);
+  Bernstein2 result{m + n, n, std::vector<double>(static_cast<std::size_t>((m + n + 1) * (n + 1)), 0.0)};
+  for (int j = 0; j <= m; ++j) {
+    std::vector<Bernstein2> level;
+    for (int k = 0; k <= n; ++k) level.push_back(Bernstein2{0, 0, {p.at(j, k)}});
+    for (int r = 1; r <= n; ++r) {
+      for (int k = 0; k + r <= n; ++k) {
+        level[k] = add(multiply(complement, level[k]), multiply(phi, level[k + 1]));
+      }
+    }
+    Bernstein2 basis{m, 0, std::vector<double>(static_cast<std::size_t>(m + 1), 0.0)};
+    basis.coefficients[j] = 1.0;
+    result = add(result, multiply(basis, level[0]));
+  }
+  return result;
+}
+
+// The bilinear phi(a, t) = e + (1 - 2e) |a - c| tau(t), tau(t) = t for e = 0 and 1 - t for
+// e = 1: on [0, 1]^2 its Bernstein coefficients are its corner values.
+Bernstein2 fanParameter(double c, double e) {
+  Bernstein2 phi{1, 1, std::vector<double>(4)};
+  for (int i = 0; i <= 1; ++i) {
+    for (int j = 0; j <= 1; ++j) {
+      const double tau = e == 0.0 ? j : 1.0 - j;
+      phi.coefficients[i * 2 + j] = e + (1.0 - 2.0 * e) * std::abs(i - c) * tau;
+    }
+  }
+  return phi;
+}
+
+BezierPatch patchOf(const std::array<Bernstein2, 3>& xyz) {
+  BezierPatch patch;
+  patch.degreeU = xyz[0].degreeU;
+  patch.degreeV = xyz[0].degreeV;
+  patch.control.resize(xyz[0].coefficients.size());
+  for (std::size_t i = 0; i < patch.control.size(); ++i) {
+    patch.control[i] = {xyz[0].coefficients[i], xyz[1].coefficients[i], xyz[2].coefficients[i]};
+  }
+  return patch;
+}
+
+// The two fans of `rectangle` (a whole patch or a quarter, its pieces' u0..v1 already set)
+// about its corner `corner` (see PatchPiece).
+std::array<PatchPiece, 2> fansAbout(const BezierPatch& rectangle, const PatchPiece& frame, int corner) {
+  const double cu = cornerU(corner), cv = cornerV(corner);
+  const std::array<Bernstein2, 3> xyz = coordinatePolynomials(rectangle);
+  std::array<Bernstein2, 3> besideU, besideV;
+  const Bernstein2 phi = fanParameter(cu, cv);  // v as a function of (a, t)
+  const Bernstein2 psi = fanParameter(cv, cu);  // u as a function of (b, s)
+  for (std::size_t c = 0; c < 3; ++c) {
+    besideU[c] = composedInV(xyz[c], phi);
+    besideV[c] = transposed(composedInV(transposed(xyz[c]), psi));
+  }
+  std::array<PatchPiece, 2> fans{frame, frame};
+  fans[0].patch = patchOf(besideU);
+  fans[1].patch = patchOf(besideV);
+  fans[0].corner = fans[1].corner = corner;
+  fans[0].besideUEdge = true;
+  fans[1].besideUEdge = false;
+  // The collapsed edges (a = cu, b = cv) are the corner point exactly, and the diagonal the
+  // two fans share has bit-equal control points (seams are recognised so): the same curve
+  // of degree m + n, its parameter a = b when cu == cv, else reversed.
+  const Vec3 apex = rectangle.at(cu == 0.0 ? 0 : rectangle.degreeU, cv == 0.0 ? 0 : rectangle.degreeV);
+  BezierPatch& a = fans[0].patch;
+  BezierPatch& b = fans[1].patch;
+  const int rowA = cu == 0.0 ? 0 : a.degreeU;
+  for (int k = 0; k <= a.degreeV; ++k) a.control[rowA * (a.degreeV + 1) + k] = apex;
+  const int columnB = cv == 0.0 ? 0 : b.degreeV;
+  for (int j = 0; j <= b.degreeU; ++j) b.control[j * (b.degreeV + 1) + columnB] = apex;
+  const int diagonalA = cv == 0.0 ? a.degreeV : 0;  // tau(t) = 1
+  const int diagonalB = cu == 0.0 ? b.degreeU : 0;  // sigma(s) = 1
+  const int d = a.degreeU;                           // == b.degreeV == m + n
+  for (int i = 0; i <= d; ++i) {
+    const int k = cu == cv ? i : d - i;
+    b.control[diagonalB * (b.degreeV + 1) + k] = a.control[i * (a.degreeV + 1) + diagonalA];
+  }
+  return fans;
+}
+
+}  // namespace
+
+Vec2 PatchPiece::sourceParameters(double s, double t) const {
+  double x = s, y = t;  // in the rectangle, [0, 1]^2
+  if (corner >= 0) {
+    const double cu = cornerU(corner), cv = cornerV(corner);
+    if (besideUEdge) {
+      const double tau = cv == 0.0 ? t : 1.0 - t;
+      x = s;
+      y = cv + (1.0 - 2.0 * cv) * std::abs(s - cu) * tau;
+    } else {
+      const double sigma = cu == 0.0 ? s : 1.0 - s;
+      x = cu + (1.0 - 2.0 * cu) * std::abs(t - cv) * sigma;
+      y = t;
+    }
+  }
+  return {u0 + (u1 - u0) * x, v0 + (v1 - v0) * y};
+}
+
+std::vector<PatchPiece> cornerPieces(const BezierPatch& patch, std::size_t source) {
+  requireWellFormed(patch, "cornerPieces");
+  PatchPiece whole;
+  whole.patch = patch;
+  whole.source = source;
+  const unsigned corners = singularCorners(patch);
+  if (corners == 0) return {whole};
+  if (patch.degreeU + patch.degreeV > kMaxPatchDegree) {
+    throw Error(fmt::format(
+        "r_u x r_v vanishes at the corner (u, v) = ({}, {}); resolving such a corner needs the "
+        "degree sum m + n <= {}, got {} + {}",
+        cornerU(std::countr_zero(corners)), cornerV(std::countr_zero(corners)), kMaxPatchDegree,
+        patch.degreeU, patch.degreeV));
+  }
+  std::vector<PatchPiece> pieces;
+  if (std::popcount(corners) == 1) {
+    for (PatchPiece& fan : fansAbout(patch, whole, std::countr_zero(corners))) pieces.push_back(std::move(fan));
+    return pieces;
+  }
+  // Several: the quarters (halved in u, then each half in v, so that shared edges are bit
+  // for bit equal), each with at most one of the patch's corners, fanned about it.
+  auto [low, high] = subdivideU(patch, 0.5);
+  for (int half = 0; half < 2; ++half) {
+    auto [lower, upper] = subdivideV(half == 0 ? low : high, 0.5);
+    for (int part = 0; part < 2; ++part) {
+      PatchPiece quarter = whole;
+      quarter.patch = part == 0 ? std::move(lower) : std::move(upper);
+      quarter.u0 = 0.5 * half, quarter.u1 = 0.5 * (half + 1);
+      quarter.v0 = 0.5 * part, quarter.v1 = 0.5 * (part + 1);
+      const int corner = half | (part << 1);  // the patch's corner inside this quarter
+      if (corners & (1u << corner)) {
+        for (PatchPiece& fan : fansAbout(quarter.patch, quarter, corner)) pieces.push_back(std::move(fan));
+      } else {
+        pieces.push_back(std::move(quarter));
+      }
+    }
+  }
+  return pieces;
+}
+
+Surface cornerResolved(const Surface& surface, std::vector<std::size_t>* sources) {
+  Surface resolved;
+  resolved.units = surface.units;
+  if (sources) sources->clear();
+  for (std::size_t i = 0; i < surface.patches.size(); ++i) {
+    for (PatchPiece& piece : cornerPieces(surface.patches[i], i)) {
+      resolved.patches.push_back(std::move(piece.patch));
+      if (sources) sources->push_back(i);
+    }
+  }
+  return resolved;
+}
+
+PatchRegularity checkPatchRegularity(const BezierPatch& patch) {
+  requireWellFormed(patch, "checkPatchRegularity");
+  if (singularCorners(patch) == 0) return checkPieceRegularity(patch);
+  // A corner where q vanishes: the patch is regular when each fan is (its normals then have a
+  // limit along every ray into the corner, the fan's collapsed edge).
+  PatchRegularity combined;
+  for (const PatchPiece& piece : cornerPieces(patch, 0)) {
+    PatchRegularity part = checkPieceRegularity(piece.patch);
+    combined.cells += part.cells;
+    if (part.verdict != RegularityVerdict::regular) {
+      const Vec2 at = piece.sourceParameters(part.u, part.v);
+      part.u = at.x, part.v = at.y, part.cells = combined.cells;
+      return part;
+    }
+  }
+  return combined;
+}
+
 namespace {
 
 // ---------------------------------------------------------------------------------------
@@ -330,7 +565,12 @@ void validatePatch(const BezierPatch& patch, std::size_t index) {
                             "curvature polynomials neither overflow nor underflow (check the units)",
                             where, scale, kMinPatchScale, kMaxPatchScale));
   }
-  const PatchRegularity regularity = checkPatchRegularity(patch);
+  PatchRegularity regularity;
+  try {
+    regularity = checkPatchRegularity(patch);
+  } catch (const Error& error) {
+    throw Error(fmt::format("{}: {}", where, error.what()));
+  }
   switch (regularity.verdict) {
     case RegularityVerdict::regular:
       return;
@@ -338,9 +578,13 @@ void validatePatch(const BezierPatch& patch, std::size_t index) {
       throw Error(fmt::format(
           "{}: degenerate patch: r_u x r_v vanishes at (u, v) = ({}, {}) (|r_u x r_v| / scale^2 = "
           "{:g} <= {:g}, scale = largest |coordinate| = {:g}), so the unit normal is undefined "
-          "there",
+          "there{}",
           where, regularity.u, regularity.v, regularity.relativeNormalLength, regularity.threshold,
-          patchScale(patch)));
+          patchScale(patch),
+          (regularity.u == 0.0 || regularity.u == 1.0) && (regularity.v == 0.0 || regularity.v == 1.0)
+              ? " (at a corner it may vanish only to first order, its direction having a limit "
+                "along every ray into the patch)"
+              : ""));
     case RegularityVerdict::undecided:
       throw Error(fmt::format(
           "{}: degenerate patch: could not prove r_u x r_v != 0 near (u, v) = ({}, {}) "

@@ -21,6 +21,7 @@
 #include "scallop/optimal_slicing.hpp"
 #include "scallop/stereographic.hpp"
 #include "scallop/surface.hpp"
+#include "corner_patches.hpp"
 #include "gauss_references.hpp"
 
 namespace {
@@ -58,7 +59,9 @@ Check checkAgainstSamples(const Surface& s, const scallop::GaussMap& map, double
   Check check;
   scallop::PlanarDomain domain;
   domain.loops = map.loops;
-  const std::vector<Vec3> normals = sampleNormals(s, n);
+  // Independent of bezier.hpp, and with rays into every corner (the arc of limits where
+  // r_u x r_v vanishes at one).
+  const std::vector<Vec3> normals = scallop::reference::sampleRegularNormals(s, n);
   auto depthOf = [&](const Vec3& m) {
     const Vec3 r = scallop::apply(map.toPoleFrame, m);
     if (r.z > 1.0 - 1e-12) return 0.0;  // the pole: a normal by construction
@@ -226,6 +229,54 @@ TEST(GaussMap, RandomMultiPatchSurfacesKeepEveryNormal) {
   EXPECT_EQ(surfaces, 16);
   std::cout << surfaces << " random surfaces: " << normals << " normals, worst depth "
             << worst / kDeg << " deg; " << boundary << " boundary points checked\n";
+}
+
+// Random patches with singular corners (tests/corner_patches.hpp), alone and three side by
+// side: the arcs of the normal's limits at the corners (rays sampled 1e-6 inside) and every
+// other sampled normal lie in Omega, and membership says yes to them.
+TEST(GaussMap, SingularCornerPatchesKeepEveryNormal) {
+  std::mt19937_64 rng(11);
+  const double tol = 0.5 * kDeg;
+  int surfaces = 0;
+  std::size_t normals = 0;
+  double worst = 0.0;
+  for (int attempt = 0; surfaces < 40 && attempt < 200; ++attempt) {
+    Surface s;
+    for (int i = 0; i < (surfaces % 4 == 3 ? 3 : 1); ++i) {
+      BezierPatch patch = scallop::test::randomCorneredPatch(rng).patch;
+      for (Vec3& p : patch.control) p.x += 5.0 * i;
+      s.patches.push_back(std::move(patch));
+    }
+    try {
+      scallop::validateSurface(s);
+    } catch (const scallop::Error&) {
+      continue;  // folds inside
+    }
+    SCOPED_TRACE("surface " + std::to_string(surfaces));
+    const scallop::GaussMap map = mapAt(s, tol);
+    ASSERT_EQ(map.kind, scallop::GaussMapKind::region);
+    const Check check = checkAgainstSamples(s, map, tol, 40);
+    normals += check.normals;
+    worst = std::max(worst, check.worstDepthRad);
+    // Membership at interior points (on an edge, a sample's own rounding can put it a hair
+    // outside the patch's normals) and on rays 1e-6 into each corner.
+    std::uniform_real_distribution<double> inside(1e-3, 1.0 - 1e-3), angle(0.01, 0.5 * std::numbers::pi - 0.01);
+    for (const BezierPatch& patch : s.patches) {
+      for (int i = 0; i < 8; ++i) {
+        const int corner = i % 4;
+        const double u0 = (corner & 1) ? 1.0 : 0.0, v0 = (corner & 2) ? 1.0 : 0.0, theta = angle(rng);
+        const double u = i < 4 ? inside(rng) : u0 + (1.0 - 2.0 * u0) * 1e-6 * std::cos(theta);
+        const double v = i < 4 ? inside(rng) : v0 + (1.0 - 2.0 * v0) * 1e-6 * std::sin(theta);
+        const Vec3 normal = scallop::normalized(scallop::cross(scallop::derivativeU(patch, u, v), scallop::derivativeV(patch, u, v)));
+        EXPECT_TRUE(scallop::isSymmetrizedNormal(s, normal)) << "(" << u << ", " << v << ")";
+        EXPECT_TRUE(scallop::isSymmetrizedNormal(s, -normal)) << "(" << u << ", " << v << ")";
+      }
+    }
+    ++surfaces;
+  }
+  EXPECT_EQ(surfaces, 40);
+  std::cout << surfaces << " surfaces with singular corners: " << normals << " normals, worst depth "
+            << worst / kDeg << " deg\n";
 }
 
 // The angle from m to the nearest point of the polylines `curves` (on the sphere; chords

@@ -106,6 +106,30 @@ inline std::vector<Vec3> sampleRegularNormals(const Surface& s, int samples) {
         if (length > tiny) out.push_back(normal / length);
       }
     }
+    // Rays into each corner at 1e-6 of the parameter range: where r_u x r_v vanishes at a
+    // corner, the normals' closure there is the arc of their limits along the rays, which a
+    // grid never comes near (elsewhere these samples repeat the corner's normal).
+    for (int corner = 0; corner < 4; ++corner) {
+      const double u0 = (corner & 1) ? 1.0 : 0.0, v0 = (corner & 2) ? 1.0 : 0.0;
+      for (int a = 0; a <= samples; ++a) {
+        const double theta = 0.5 * std::numbers::pi * a / samples;
+        const double u = u0 + (1.0 - 2.0 * u0) * 1e-6 * std::cos(theta);
+        const double v = v0 + (1.0 - 2.0 * v0) * 1e-6 * std::sin(theta);
+        const std::vector<double> bu = basis(m, u), du = basis(m - 1, u);
+        const std::vector<double> bv = basis(n, v), dv = basis(n - 1, v);
+        Vec3 ru{0.0, 0.0, 0.0};
+        Vec3 rv{0.0, 0.0, 0.0};
+        for (int j = 0; j <= m; ++j) {
+          for (int k = 0; k <= n; ++k) {
+            if (j < m) ru = ru + (m * du[j] * bv[k]) * (p.at(j + 1, k) - p.at(j, k));
+            if (k < n) rv = rv + (n * bu[j] * dv[k]) * (p.at(j, k + 1) - p.at(j, k));
+          }
+        }
+        const Vec3 normal = cross(ru, rv);
+        const double length = norm(normal);
+        if (length > tiny) out.push_back(normal / length);
+      }
+    }
   }
   return out;
 }
@@ -349,6 +373,30 @@ inline double nearestNormalAngle(const Surface& s, const Vec3& direction, int gr
       if (!improved) step *= 0.5;
     }
     best = std::min(best, local);
+    // Rays into each corner at 1e-6 (see sampleRegularNormals): the arc of limits where
+    // r_u x r_v vanishes at a corner, sampled, the best ray refined by golden sections.
+    for (int corner = 0; corner < 4; ++corner) {
+      const double u0 = (corner & 1) ? 1.0 : 0.0, v0 = (corner & 2) ? 1.0 : 0.0;
+      auto atRay = [&](double theta) {
+        return angleAt(u0 + (1.0 - 2.0 * u0) * 1e-6 * std::cos(theta),
+                       v0 + (1.0 - 2.0 * v0) * 1e-6 * std::sin(theta));
+      };
+      const int rays = 4 * grid;
+      int bestRay = 0;
+      double rayValue = 10.0;
+      for (int a = 0; a <= rays; ++a) {
+        const double value = atRay(0.5 * std::numbers::pi * a / rays);
+        if (value < rayValue) rayValue = value, bestRay = a;
+      }
+      double lo = 0.5 * std::numbers::pi * std::max(0, bestRay - 1) / rays;
+      double hi = 0.5 * std::numbers::pi * std::min(rays, bestRay + 1) / rays;
+      const double ratio = 0.5 * (std::sqrt(5.0) - 1.0);
+      for (int step = 0; step < 60; ++step) {
+        const double a = hi - ratio * (hi - lo), b = lo + ratio * (hi - lo);
+        if (atRay(a) < atRay(b)) hi = b; else lo = a;
+      }
+      best = std::min({best, rayValue, atRay(0.5 * (lo + hi))});
+    }
   }
   return best;
 }

@@ -6,17 +6,20 @@
 
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <numbers>
 #include <random>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "corner_patches.hpp"
 #include "message_checks.hpp"
 #include "scallop/bernstein.hpp"
 #include "scallop/bezier.hpp"
@@ -686,6 +689,144 @@ TEST(Surface, SingularVerdictsAreBackedByTheThreshold) {
       EXPECT_EQ(regularity.verdict, RegularityVerdict::singular) << pinch;
     }
   }
+}
+
+}  // namespace
+}  // namespace scallop
+
+// ---------------------------------------------------------------------------------------
+// Corners where r_u x r_v vanishes (cornerPieces)
+// ---------------------------------------------------------------------------------------
+
+namespace scallop {
+namespace {
+
+// The unit normal at (u, v) straight from r_u x r_v (no limits, no fallbacks).
+Vec3 crossNormal(const BezierPatch& patch, double u, double v) {
+  return normalized(cross(derivativeU(patch, u, v), derivativeV(patch, u, v)));
+}
+
+// The limit of the normal at `corner` along the ray at angle theta into the patch, taken at
+// 1e-7 of the parameter range (the error of that is O(1e-7)).
+Vec3 rayNormal(const BezierPatch& patch, int corner, double theta) {
+  const double u0 = (corner & 1) ? 1.0 : 0.0, v0 = (corner & 2) ? 1.0 : 0.0;
+  return crossNormal(patch, u0 + (1.0 - 2.0 * u0) * 1e-7 * std::cos(theta),
+                     v0 + (1.0 - 2.0 * v0) * 1e-7 * std::sin(theta));
+}
+
+// 2,000 random patches with one to four singular corners of each kind (fixed seed): those
+// the regularity check accepts are split into pieces that reproduce the patch (points and
+// normals at their source parameters), cover its parameter square once (the pieces' signed
+// parameter areas sum to 1, each positive: the orientation is kept), and whose apex rows
+// carry the normal's limits along the rays into the corner.
+TEST(CornerPieces, ReproduceThePatchAndItsNormals) {
+  std::mt19937_64 rng(20261125);
+  int accepted = 0, fanned = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    const test::CorneredPatch cornered = test::randomCorneredPatch(rng);
+    const BezierPatch& patch = cornered.patch;
+    if (checkPatchRegularity(patch).verdict != RegularityVerdict::regular) continue;
+    ++accepted;
+    SCOPED_TRACE("trial " + std::to_string(trial));
+    const std::vector<PatchPiece> pieces = cornerPieces(patch, 7);
+    double area = 0.0;
+    for (const PatchPiece& piece : pieces) {
+      EXPECT_EQ(piece.source, 7u);
+      fanned += piece.corner >= 0;
+      EXPECT_EQ(checkPatchRegularity(piece.patch).verdict, RegularityVerdict::regular);
+      // Signed area by the midpoint rule on 16 x 16 cells: exact for the maps used (their
+      // Jacobians are linear in each parameter).
+      const int cells = 16;
+      const double h = 1.0 / cells, dh = 1e-6;
+      for (int a = 0; a < cells; ++a) {
+        for (int b = 0; b < cells; ++b) {
+          const double s = (a + 0.5) * h, t = (b + 0.5) * h;
+          const Vec2 ds = (piece.sourceParameters(s + dh, t) - piece.sourceParameters(s - dh, t)) * (0.5 / dh);
+          const Vec2 dt = (piece.sourceParameters(s, t + dh) - piece.sourceParameters(s, t - dh)) * (0.5 / dh);
+          const double jacobian = ds.x * dt.y - ds.y * dt.x;
+          EXPECT_GT(jacobian, 0.0);
+          area += jacobian * h * h;
+        }
+      }
+      for (int a = 0; a <= 8; ++a) {
+        for (int b = 0; b <= 8; ++b) {
+          const double s = a / 8.0, t = b / 8.0;
+          const Vec2 uv = piece.sourceParameters(s, t);
+          EXPECT_LE(norm(point(piece.patch, s, t) - point(patch, uv.x, uv.y)), 1e-13 * 8.0);
+          const bool nearCorner = piece.corner >= 0 && std::min({uv.x, 1.0 - uv.x}) < 1e-3 &&
+                                  std::min({uv.y, 1.0 - uv.y}) < 1e-3;
+          if (!nearCorner) {
+            EXPECT_LE(norm(unitNormal(piece.patch, s, t) - crossNormal(patch, uv.x, uv.y)), 1e-9);
+          }
+        }
+      }
+      if (piece.corner < 0) continue;
+      // The apex row: its normals are the ray limits, from the corner of the source patch
+      // (the quarter's corner is the patch's own). Parameter a along the row runs over the
+      // ray's direction as sourceParameters says.
+      for (int i = 0; i <= 10; ++i) {
+        const double t = i / 10.0;
+        // A point just off the apex row, and the ray from the corner through it.
+        const double cu = (piece.corner & 1) ? 1.0 : 0.0, cv = (piece.corner & 2) ? 1.0 : 0.0;
+        const double s0 = piece.besideUEdge ? cu : t, t0 = piece.besideUEdge ? t : cv;
+        const double s1 = piece.besideUEdge ? cu + (1.0 - 2.0 * cu) * 1e-3 : t;
+        const double t1 = piece.besideUEdge ? t : cv + (1.0 - 2.0 * cv) * 1e-3;
+        const Vec2 apex = piece.sourceParameters(s0, t0);
+        const Vec2 off = piece.sourceParameters(s1, t1);
+        const int c = (apex.x == 1.0 ? 1 : 0) | (apex.y == 1.0 ? 2 : 0);
+        ASSERT_TRUE((apex.x == 0.0 || apex.x == 1.0) && (apex.y == 0.0 || apex.y == 1.0));
+        const double theta = std::atan2(std::abs(off.y - apex.y), std::abs(off.x - apex.x));
+        EXPECT_LE(norm(unitNormal(piece.patch, s0, t0) - rayNormal(patch, c, theta)), 1e-5);
+      }
+    }
+    EXPECT_NEAR(area, 1.0, 1e-9);
+  }
+  std::printf("[          ] %d of 2000 accepted, %d fans\n", accepted, fanned);
+  EXPECT_GE(accepted, 1000);
+  EXPECT_GE(fanned, 1000);
+}
+
+// A corner where r_u x r_v vanishes to first order is regular: validateSurface accepts it,
+// and unitNormal there is the limit along the diagonal ray (near it, along its own ray).
+TEST(CornerPieces, FirstOrderCornerZerosAreAccepted) {
+  for (int corner = 0; corner < 4; ++corner) {
+    SCOPED_TRACE("corner " + std::to_string(corner));
+    BezierPatch patch = makePatch(3, 3, [](int j, int k) { return Vec3{double(k), double(j), 0.1 * j * k - 0.05 * k * k}; });
+    const int j0 = (corner & 1) ? 3 : 0, k0 = (corner & 2) ? 3 : 0, k1 = (corner & 2) ? 2 : 1;
+    patch.control[j0 * 4 + k1] = patch.control[j0 * 4 + k0];  // p_{j0,k1} = p_{j0,k0}: r_v = 0
+    const double u0 = (corner & 1) ? 1.0 : 0.0, v0 = (corner & 2) ? 1.0 : 0.0;
+    EXPECT_LE(norm(normalVector(patch, u0, v0)), 1e-15);
+    EXPECT_EQ(checkPatchRegularity(patch).verdict, RegularityVerdict::regular);
+    EXPECT_NO_THROW(validateSurface(Surface{Units::inch, {patch}}));
+    EXPECT_EQ(cornerPieces(patch).size(), 2u);
+    EXPECT_LE(norm(unitNormal(patch, u0, v0) - rayNormal(patch, corner, std::numbers::pi / 4.0)), 1e-6);
+    const double theta = 0.3;
+    const double u = u0 + (1.0 - 2.0 * u0) * 1e-9 * std::cos(theta), v = v0 + (1.0 - 2.0 * v0) * 1e-9 * std::sin(theta);
+    EXPECT_LE(norm(unitNormal(patch, u, v) - rayNormal(patch, corner, theta)), 1e-6);
+  }
+}
+
+// Where r_u x r_v vanishes to second order at a corner (both r_u and r_v zero; the planar
+// map (u + i v)^2, whose Jacobian is 4 |u + i v|^2), the normal has no limit along some ray
+// or none at all: rejected, the message naming the corner.
+TEST(CornerPieces, HigherOrderCornerZerosAreRejected) {
+  BezierPatch both = makePatch(3, 3, [](int j, int k) { return Vec3{double(k), double(j), 0.2 * j * k}; });
+  both.control[1] = both.control[0];  // p01 = p00
+  both.control[4] = both.control[0];  // p10 = p00
+  const PatchRegularity regularity = checkPatchRegularity(both);
+  EXPECT_NE(regularity.verdict, RegularityVerdict::regular);
+  EXPECT_EQ(checkPatchRegularity(squaringPatch(0.0, 0.0)).verdict, RegularityVerdict::singular);
+  Surface surface{Units::inch, {both}};
+  expectMessageContains(parseError(surfaceToJson(surface)),
+                        {"s.json: patches[0]", "degenerate", "(u, v) = (0, 0)", "at a corner"}, "second order");
+}
+
+// Fans of a degree sum above kMaxPatchDegree are refused with the reason, not built.
+TEST(CornerPieces, DegreeSumBeyondTheLimitIsAClearError) {
+  BezierPatch patch = makePatch(12, 12, [](int j, int k) { return Vec3{double(k), double(j), 0.01 * j * k}; });
+  patch.control[1] = patch.control[0];
+  expectMessageContains(parseError(surfaceToJson(Surface{Units::inch, {patch}})),
+                        {"s.json: patches[0]", "corner", "m + n <= 20"}, "degree sum");
 }
 
 }  // namespace

@@ -78,8 +78,10 @@ Vec3 secondDerivative(const BezierPatch& patch, double u, double v, int du, int 
 /// r_u x r_v, not normalised (zero where the patch is not regular).
 Vec3 normalVector(const BezierPatch& patch, double u, double v);
 /// The unit normal of eq. (2); on a collapsed edge (an apex row), its limit from inside the
-/// patch (normalDirectionPolynomials); throws scallop::Error naming (u, v) where r_u x r_v
-/// vanishes otherwise.
+/// patch (normalDirectionPolynomials); within 1e-6 of a corner where q vanishes to first
+/// order (surface.hpp's cornerPieces), the limit along the ray from the corner through
+/// (u, v) (at the corner itself, along the diagonal); throws scallop::Error naming (u, v)
+/// where r_u x r_v vanishes otherwise.
 Vec3 unitNormal(const BezierPatch& patch, double u, double v);
 
 /// r_u, r_v, r_uu, r_uv and r_vv at one point, from the Bernstein basis and its derivatives

@@ -24,8 +24,12 @@
 // one point, an apex as on the Utah teapot's knob and bottom, makes r_u x r_v vanish along
 // that edge, and the unit normal there is the limit q / |q|); so that its unit normal (eq 2)
 // is defined everywhere, by continuity on such edges. A cone's apex (limits that differ from
-// ray to ray) is accepted so too: its normals are those limits. Nets collapsed to a point or a
-// line, and corners or interior points where q vanishes, are rejected.
+// ray to ray) is accepted so too: its normals are those limits. So is a corner where q itself
+// vanishes if its direction has a limit along every ray into the patch (two coincident
+// corner control points, r_u parallel to r_v at the corner): the patch is then checked as
+// the fans of cornerPieces, on which the corner is an apex row. Nets collapsed to a point or
+// a line, corners where q vanishes to higher order (no limit along some ray), and interior
+// points where q vanishes are rejected.
 // Degree 0 in a direction is rejected: r_u or r_v would vanish identically. (Accepted
 // patches also satisfy |r_u x r_v| > 1e-12 S_u S_v, above the threshold where bezier.hpp's
 // unitNormal throws, so unitNormal never throws on them.)
@@ -155,6 +159,56 @@ struct PatchRegularity {
 /// Decides whether a patch is regular (see the contract). The patch must have degrees >= 1
 /// and (m + 1)(n + 1) finite control points.
 PatchRegularity checkPatchRegularity(const BezierPatch& patch);
+
+/// tau / scale^2 of the contract: |q| <= tau is a zero of q.
+constexpr double kRelativeNormalTolerance = 1e-12;
+
+/// A piece of a patch (cornerPieces): its own Bezier patch, and where its parameters land on
+/// the source patch's.
+///
+/// A corner where q vanishes while its direction has a limit along every ray into the patch
+/// (q = (u - u_c) q_u + (v - v_c) q_v + ..., cos(theta) q_u + sin(theta) q_v != 0 on the
+/// quadrant: two coincident control points p00 = p01, or r_u parallel to r_v there) is
+/// blown up: the rectangle is cut along its diagonal through the corner into two fans, each
+/// reparametrized polynomially so that the corner becomes a collapsed edge (an apex row), on
+/// which q's direction is the limit along each ray. For the corner (0, 0):
+///   beside the edge v = 0: (a, t) -> (u, v) = (a, a t),  r(a, a t), bidegree (m + n, n);
+///   beside the edge u = 0: (s, b) -> (u, v) = (b s, b),  r(b s, b), bidegree (m, m + n);
+/// their Jacobians a and b are positive inside, so the orientation (the normal's sign) is
+/// kept, and r_a x r_t = a (r_u x r_v)(a, a t) = a^2 (q_u + t q_v + O(a)): two edge factors
+/// that normalDirectionPolynomials divides out, leaving the ray limits on the apex row.
+/// The other corners are mirror images, with t or s reversed to keep the orientation.
+struct PatchPiece {
+  BezierPatch patch;
+  std::size_t source = 0;  ///< the source patch's index in its surface
+  /// The rectangle of the source's [0, 1]^2 the piece lies in: the whole patch, or a quarter
+  /// when several corners are blown up (one per quarter).
+  double u0 = 0.0, u1 = 1.0, v0 = 0.0, v1 = 1.0;
+  /// -1: the piece is the rectangle itself. Else the rectangle's blown-up corner (bit 0 set:
+  /// u = u1, bit 1 set: v = v1), and which fan: the one beside the rectangle's edge through
+  /// the corner along u (besideUEdge, parameters (a, t)) or along v (parameters (s, b)).
+  int corner = -1;
+  bool besideUEdge = false;
+  /// The source's (u, v) at the piece's parameters (s, t) in [0, 1]^2.
+  Vec2 sourceParameters(double s, double t) const;
+};
+
+/// The patch as pieces without corners where q vanishes: {the patch itself} when it has
+/// none (the usual case, a copy); else two fans about its one such corner, or its four
+/// quarters (halved at 1/2, shared edges bit for bit equal) with the two fans about each
+/// quarter's corner that is one of them. The pieces cover the patch exactly (up to rounding
+/// of their control points) and share its unit normals: n_piece(s, t) = n(sourceParameters(s,
+/// t)), on a fan's apex row the limit along the ray. Corners are found as in the regularity
+/// check (|q| <= tau there). Throws scallop::Error for a malformed patch, and when a corner
+/// must be blown up but m + n > kMaxPatchDegree (the fans' degree). Time: O((m + n)^2 n^3)
+/// per fan, O((mn)^2) to look for corners.
+std::vector<PatchPiece> cornerPieces(const BezierPatch& patch, std::size_t source = 0);
+
+/// Every patch of `surface` replaced by its cornerPieces, in order; `sources`, if given,
+/// receives each piece's source patch index. Every algorithm that needs the unit normal's
+/// direction field on the closed patch (the Gauss map, the coverage proof, the optimal
+/// slicing's polish and certificate) works on these pieces.
+Surface cornerResolved(const Surface& surface, std::vector<std::size_t>* sources = nullptr);
 
 /// The largest |coordinate| over all control points (0 for no patches): the length scale
 /// for tolerances.
