@@ -17,6 +17,7 @@
 
 #include "cli_fixture.hpp"
 #include "scallop/optimal_slicing.hpp"
+#include "scallop/surface.hpp"
 
 namespace scallop {
 namespace {
@@ -190,6 +191,28 @@ TEST_F(OrientCli, ReadsStandardInputAndCreatesNestedFigureDirectories) {
   EXPECT_LT(degreesFromPaperOptimum(Json::parse(result.out).at("normal")), 1.0);
   EXPECT_EQ(listing("out/figs"),
             (std::vector<std::string>{"gauss-map.svg", "stereographic.svg"}));
+}
+
+// A corner where r_u x r_v vanishes to first order (paper-1 with p01 = p00) is a surface like
+// any other; one where it vanishes to second order (p10 = p00 too) is refused, the message
+// naming the corner.
+TEST_F(OrientCli, CornersWhereTheNormalVanishes) {
+  Surface surface = exampleSurface("paper-1");
+  surface.patches[0].control[1] = surface.patches[0].control[0];
+  write("corner.json", surfaceToJson(surface));
+  const RunResult accepted = run("orient corner.json --json out.json");
+  ASSERT_EQ(accepted.exitCode, 0) << accepted.err;
+  const Json json = Json::parse(readFile(workDir_ / "out.json"));
+  EXPECT_TRUE(json.at("certified").get<bool>());
+  EXPECT_EQ(json.at("method").get<std::string>(), "medial-axis");
+  surface.patches[0].control[4] = surface.patches[0].control[0];
+  write("second.json", surfaceToJson(surface));
+  const RunResult refused = run("orient second.json --json out2.json");
+  EXPECT_EQ(refused.exitCode, 1);
+  for (const char* part : {"scallop: error: second.json", "patches[0]", "(u, v) = (0, 0)", "at a corner"}) {
+    EXPECT_NE(refused.err.find(part), std::string::npos) << refused.err;
+  }
+  EXPECT_FALSE(fs::exists(workDir_ / "out2.json"));
 }
 
 TEST_F(OrientCli, Help) {
