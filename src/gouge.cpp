@@ -586,6 +586,149 @@ ClosestPoint search(const Surface& surface, const std::vector<PatchTree>& trees,
 }
 
 // ---------------------------------------------------------------------------------------
+// Segment clearance
+// ---------------------------------------------------------------------------------------
+
+// The point of the segment [a, b] nearest to p.
+Vec3 nearestOnSegment(Vec3 a, Vec3 b, Vec3 p) {
+  const Vec3 ab = b - a;
+  const double length2 = dot(ab, ab);
+  if (!(length2 > 0.0)) return a;
+  return a + std::clamp(dot(p - a, ab) / length2, 0.0, 1.0) * ab;
+}
+
+// A lower bound of the distance between a box and the segment [a, b]: the gap between the
+// box and the segment's own box (exact for an axis-parallel segment, loose for a diagonal
+// one; the separating plane below takes over there).
+double boxSegmentDistance(const Box& box, Vec3 a, Vec3 b) {
+  const Vec3 lo{std::min(a.x, b.x), std::min(a.y, b.y), std::min(a.z, b.z)};
+  const Vec3 hi{std::max(a.x, b.x), std::max(a.y, b.y), std::max(a.z, b.z)};
+  const double dx = std::max({0.0, box.lo.x - hi.x, lo.x - box.hi.x});
+  const double dy = std::max({0.0, box.lo.y - hi.y, lo.y - box.hi.y});
+  const double dz = std::max({0.0, box.lo.z - hi.z, lo.z - box.hi.z});
+  return std::sqrt(dx * dx + dy * dy + dz * dz);
+}
+
+// A separating plane between the cell and the segment: w the unit direction from the
+// segment's point nearest to the mean of the net's corners to that mean; every point of the
+// cell's convex hull lies at least min_i c_i . w along w, every point of the segment at most
+// max(a . w, b . w) (a linear function's maximum is at an end), so their distance is at
+// least the difference. Near a contact w tends to the common normal, along which the net is
+// O(h^2) thin and a segment tangent to the offset surface O(length^2) thick.
+double separatingPlaneSegmentDistance(const Vec3* net, int m, int n, Vec3 a, Vec3 b) {
+  const int stride = n + 1;
+  const Vec3 mean = 0.25 * (net[0] + net[n] + net[m * stride] + net[m * stride + n]);
+  const Vec3 toCell = mean - nearestOnSegment(a, b, mean);
+  const double length = norm(toCell);
+  if (!(length > 0.0)) return 0.0;
+  const Vec3 w = toCell / length;
+  double least = kInfinity;
+  const int count = (m + 1) * stride;
+  for (int i = 0; i < count; ++i) least = std::min(least, dot(net[i], w));
+  return std::max(0.0, least - std::max(dot(a, w), dot(b, w)));
+}
+
+SegmentClearance segmentSearch(const std::vector<PatchTree>& trees, Vec3 a, Vec3 b, double clearance, std::size_t maxCells) {
+  if (!isFinite(a) || !isFinite(b)) {
+    throw Error(fmt::format("segment clearance: the segment ({}, {}, {}) - ({}, {}, {}) is not "
+                            "finite", a.x, a.y, a.z, b.x, b.y, b.z));
+  }
+  if (!std::isfinite(clearance)) throw Error("segment clearance: the clearance is not finite");
+  thread_local Scratch scratch;
+  std::vector<Cell>& heap = scratch.heap;
+  std::vector<Vec3>& arena = scratch.arena;
+  heap.clear();
+  arena.clear();
+  SegmentClearance result;
+  const double pScale = std::max(maxAbs(a), maxAbs(b));
+  const auto allowanceOf = [&](const PatchTree& tree, int depth) {
+    return (3.0 * (tree.degreeU + tree.degreeV) * (depth + 1) + 16.0) * kUnitRoundoff *
+           (tree.scale + pScale);
+  };
+  const auto netOf = [&](const Cell& cell) -> const Vec3* {
+    const PatchTree& tree = trees[cell.patch];
+    return cell.inTree
+               ? tree.nets[static_cast<std::size_t>(cell.depth)].data() + cell.net * tree.stride
+               : arena.data() + cell.net;
+  };
+  // A surface point nearer than the clearance refutes it; the nearest seen is kept.
+  bool violated = false;
+  const auto consider = [&](Vec3 q, std::uint32_t patch, double u, double v) {
+    const double d = norm(q - nearestOnSegment(a, b, q));
+    if (d < result.distance) {
+      result.distance = d;
+      result.patch = patch;
+      result.u = u;
+      result.v = v;
+      result.point = q;
+    }
+    if (d < clearance) violated = true;
+  };
+  const auto offer = [&](Cell cell) {
+    ++result.cells;
+    const PatchTree& tree = trees[cell.patch];
+    const int m = tree.degreeU;
+    const int n = tree.degreeV;
+    const Vec3* net = netOf(cell);
+    const double h = std::ldexp(1.0, -cell.depth);
+    consider(net[0], cell.patch, cell.u0, cell.v0);
+    consider(net[n], cell.patch, cell.u0, cell.v0 + h);
+    consider(net[m * (n + 1)], cell.patch, cell.u0 + h, cell.v0);
+    consider(net[m * (n + 1) + n], cell.patch, cell.u0 + h, cell.v0 + h);
+    const double allowance = allowanceOf(tree, cell.depth);
+    const Box box = cell.inTree ? tree.boxes[static_cast<std::size_t>(cell.depth)][cell.net]
+                                : boxOf(net, tree.stride);
+    double lower = boxSegmentDistance(box, a, b);
+    if (lower - allowance < clearance) {
+      lower = std::max(lower, separatingPlaneSegmentDistance(net, m, n, a, b));
+    }
+    cell.lower = lower - allowance;
+    if (cell.lower >= clearance) return;  // proven clear
+    heap.push_back(cell);
+    std::push_heap(heap.begin(), heap.end(), ByLowerBound{});
+  };
+  for (std::size_t i = 0; i < trees.size() && !violated; ++i) {
+    offer({0.0, static_cast<std::uint32_t>(i), 0, true, 0, 0.0, 0.0});
+  }
+  while (!heap.empty() && !violated) {
+    std::pop_heap(heap.begin(), heap.end(), ByLowerBound{});
+    const Cell cell = heap.back();
+    heap.pop_back();
+    const PatchTree& tree = trees[cell.patch];
+    const double h = std::ldexp(1.0, -cell.depth);
+    if (cell.depth >= kMaxCellDepth || result.cells >= maxCells) {
+      result.verdict = Clearance::undecided;
+      return result;
+    }
+    const double half = 0.5 * h;
+    const std::size_t stride = tree.stride;
+    if (cell.inTree && cell.depth + 1 < tree.levels) {
+      const auto side = std::size_t{1} << cell.depth;
+      const std::size_t iu = cell.net / side;
+      const std::size_t iv = cell.net % side;
+      for (std::size_t i = 0; i < 2; ++i) {
+        for (std::size_t j = 0; j < 2; ++j) {
+          offer({0.0, cell.patch, cell.depth + 1, true, (2 * iu + i) * (2 * side) + (2 * iv + j),
+                 cell.u0 + static_cast<double>(i) * half, cell.v0 + static_cast<double>(j) * half});
+        }
+      }
+    } else {
+      const std::size_t first = arena.size();
+      arena.resize(first + 4 * stride);  // may move the arena: take the parent's net after
+      halveNet(netOf(cell), tree.degreeU, tree.degreeV, arena.data() + first);
+      for (std::size_t i = 0; i < 2; ++i) {
+        for (std::size_t j = 0; j < 2; ++j) {
+          offer({0.0, cell.patch, cell.depth + 1, false, first + (2 * i + j) * stride,
+                 cell.u0 + static_cast<double>(i) * half, cell.v0 + static_cast<double>(j) * half});
+        }
+      }
+    }
+  }
+  result.verdict = violated ? Clearance::violated : Clearance::proven;
+  return result;
+}
+
+// ---------------------------------------------------------------------------------------
 // Tool-path sampling
 // ---------------------------------------------------------------------------------------
 
@@ -761,6 +904,12 @@ ClosestPoint SurfaceDistance::closest(Vec3 p) const { return closest(p, kInfinit
 
 ClosestPoint SurfaceDistance::closest(Vec3 p, double cutoff) const {
   return search(surface_, trees_, tolerance_, options_.maxCells, p, cutoff);
+}
+
+SegmentClearance SurfaceDistance::segmentClearance(Vec3 a, Vec3 b, double clearance,
+                                                   std::size_t maxCells) const {
+  if (maxCells < 1) throw Error("segment clearance: maxCells must be >= 1");
+  return segmentSearch(trees_, a, b, clearance, maxCells);
 }
 
 double distanceToSurface(const Surface& surface, Vec3 p, const DistanceOptions& options) {

@@ -533,6 +533,55 @@ double bestRasterAngle(const Surface& surface) {
   return bestAngle >= kPi ? 0.0 : bestAngle;
 }
 
+namespace {
+
+double moveLength(Vec3 from, const ToolMove& move) {
+  if (move.kind == MoveKind::line) return norm(move.end - from);
+  const Vec3 a = toArcPlane(move.plane, from - move.center);
+  const Vec3 b = toArcPlane(move.plane, move.end - move.center);
+  double sweep = std::atan2(b.y, b.x) - std::atan2(a.y, a.x);
+  const double turn = 2.0 * std::numbers::pi;
+  if (move.clockwise) {
+    while (sweep >= 0.0) sweep -= turn;
+  } else {
+    while (sweep <= 0.0) sweep += turn;
+  }
+  return std::hypot(0.5 * (std::hypot(a.x, a.y) + std::hypot(b.x, b.y)) * sweep, b.z - a.z);
+}
+
+// The passes lifted to the drop envelope; the move counts of RasterPass and the lengths
+// recomputed on the lifted moves.
+void liftRasterPaths(const SurfaceDistance& distance, double depthTolerance, RasterPaths& out) {
+  EnvelopeOptions envelope;
+  envelope.depthTolerance = depthTolerance;
+  std::vector<std::vector<std::size_t>> moveMap;
+  out.path = liftToDropEnvelope(distance, out.path, envelope, out.envelope, &moveMap);
+  out.stats.centreLength = 0.0;
+  out.linkLength = 0.0;
+  for (std::size_t p = 0; p < out.path.passes.size(); ++p) {
+    RasterPass& info = out.passes[p];
+    const std::vector<std::size_t>& map = moveMap[p];
+    const ToolPass& pass = out.path.passes[p];
+    // Output moves [0, cutFirst) are the link and entry, [cutFirst, cutLast) the cut.
+    const std::size_t inputMoves = map.size();
+    const std::size_t linkEnd = info.linkMoves == 0 ? 0 : map[info.linkMoves - 1];
+    const std::size_t entryIn = info.linkMoves + info.entryMoves;
+    const std::size_t cutFirst = entryIn == 0 ? 0 : map[entryIn - 1];
+    const std::size_t cutLast = info.exitMoves == 0 ? pass.moves.size() : map[inputMoves - 2];
+    info.linkMoves = linkEnd;
+    info.entryMoves = cutFirst - linkEnd;
+    info.exitMoves = pass.moves.size() - cutLast;
+    Vec3 at = pass.start;
+    for (std::size_t m = 0; m < pass.moves.size(); ++m) {
+      const double length = moveLength(at, pass.moves[m]);
+      (m >= cutFirst && m < cutLast ? out.stats.centreLength : out.linkLength) += length;
+      at = pass.moves[m].end;
+    }
+  }
+}
+
+}  // namespace
+
 RasterPaths rasterPaths(const Surface& surface, const RasterOptions& options) {
   validateSurface(surface);
   requirePositive("the tool radius", options.toolRadius);
@@ -549,6 +598,7 @@ RasterPaths rasterPaths(const Surface& surface, const RasterOptions& options) {
   }
   requireNonNegative("the chordal tolerance", options.chordalTolerance);
   requireNonNegative("the arc tolerance", options.arcTolerance);
+  requireNonNegative("the depth tolerance", options.depthTolerance);
   const double scale = std::max(surfaceScale(surface), 1e-300);
   const double tolerance =
       options.chordalTolerance > 0.0 ? options.chordalTolerance : 1e-4 * scale;
@@ -658,6 +708,7 @@ RasterPaths rasterPaths(const Surface& surface, const RasterOptions& options) {
     throw Error(fmt::format(
         "no plane e . r = k * {} with e = ({}, {}, 0) cuts the surface (e . r spans [{}, {}])",
         out.spacing, frame.e.x, frame.e.y, range.lo, range.hi));
+  if (options.dropEnvelope) liftRasterPaths(distance, options.depthTolerance, out);
   return out;
 }
 

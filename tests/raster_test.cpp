@@ -430,8 +430,11 @@ Checked checkRaster(const Surface& surface, const RasterPaths& r, double angle, 
   return out;
 }
 
+// The scallop hull's paths as they are, exact in their planes (the stage the checker above
+// judges); the drop envelope on top is tests/envelope_test.cpp's.
 RasterPaths run(const Surface& s, double angle, double R, double spacing) {
   RasterOptions o;
+  o.dropEnvelope = false;
   o.angleRad = angle;
   o.toolRadius = R;
   o.spacing = spacing;
@@ -686,6 +689,7 @@ TEST(Raster, BestAngleOptionAndScallopHeight) {
   o.bestAngle = true;
   o.toolRadius = 0.25;
   o.scallopHeight = 0.001;
+  o.dropEnvelope = false;
   const RasterPaths r = scallop::rasterPaths(s, o);
   EXPECT_EQ(r.angleRad, scallop::bestRasterAngle(s));
   EXPECT_GT(r.alphaRad, 0.0);
@@ -761,6 +765,7 @@ TEST(Raster, PaperFigures) {
       o.toolRadius = 0.25;
       (fixed ? o.spacing : o.scallopHeight) = fixed ? 0.05 : 0.001;
       o.bestAngle = best;
+      o.dropEnvelope = false;  // the hull stage's figures (the envelope's: scallop-bench)
       const auto t0 = std::chrono::steady_clock::now();
       const RasterPaths r = scallop::rasterPaths(s, o);
       const double ms =

@@ -149,6 +149,38 @@ struct ClosestPoint {
   std::size_t cells = 0;  ///< cells whose bounds were computed
 };
 
+/// The verdict of a segment clearance test (SurfaceDistance::segmentClearance).
+enum class Clearance {
+  proven,     ///< every point of the segment is at least the clearance from the surface
+  violated,   ///< a surface point lies nearer than the clearance to the segment (`point`)
+  undecided,  ///< neither within the cell budget (or at kMaxCellDepth)
+};
+
+/// Whether a straight segment keeps a clearance from the surface: the ball of radius R
+/// swept along it cuts no deeper than R - clearance.
+/// Method: branch and bound over sub-patch cells as for a point, with two lower bounds of
+/// the distance between a cell and the segment (convex hull property): the gap between the
+/// cell's box and the segment's box, and a separating plane whose normal w points from the
+/// segment's point nearest the cell (the mean of its corners) to that cell: min_i c_i . w -
+/// max(a . w, b . w). Both are lowered by the rounding allowance of the point query. A cell
+/// whose bound reaches the clearance is dropped; its corners are surface points,
+/// and one nearer than the clearance to the segment refutes it at once. Near a contact the
+/// plane bound lags by the net's thickness, O(h^2), plus the segment's bow against the
+/// surface, so a segment whose true clearance exceeds the asked one by d is proven once the
+/// cells are about sqrt(d / curvature) small (with a segment no longer than that).
+/// Cost: tens of cells for a short segment beside the surface; at most maxCells.
+struct SegmentClearance {
+  Clearance verdict = Clearance::undecided;
+  /// The surface point nearest to the segment among those seen (infinity if none), with its
+  /// patch and parameters: for `violated`, a point nearer than the clearance.
+  double distance = std::numeric_limits<double>::infinity();
+  std::size_t patch = 0;
+  double u = 0.0;
+  double v = 0.0;
+  Vec3 point;
+  std::size_t cells = 0;  ///< cells bounded
+};
+
 /// Distance queries against one surface: the per-patch quadtrees are built once (see the
 /// contract), so prefer this to distanceToSurface for many queries. Holds a copy of the
 /// surface.
@@ -162,6 +194,11 @@ class SurfaceDistance {
   ClosestPoint closest(Vec3 p) const;
   /// The same, giving up on everything at distance >= cutoff (early exit, see the contract).
   ClosestPoint closest(Vec3 p, double cutoff) const;
+
+  /// Whether every point of the segment [a, b] (finite) is at least `clearance` from the
+  /// surface (see SegmentClearance). Throws scallop::Error for non-finite input.
+  SegmentClearance segmentClearance(Vec3 a, Vec3 b, double clearance,
+                                    std::size_t maxCells = 100'000) const;
 
   /// The absolute tolerance in use (the default resolved).
   double tolerance() const { return tolerance_; }

@@ -88,10 +88,20 @@
 //         the exit and entry points, proven clear up to Zc and clear above it.
 // Gouging: the offset in the section plane rules out gouging within that plane only; the
 //         ball may still cut into the surface beside the plane where the surface rises
-//         across it. gouge.hpp measures the deepest interference along this path.
+//         across it (on the paper's surface 1 with R = 0.25 in, 0.19 in deep at pass ends and
+//         0.006 in over the part). So, by default (dropEnvelope), every pass, its link, entry
+//         and exit included, is then lifted to the drop envelope (envelope.hpp): each vertex
+//         straight up to the lowest position where the ball and shank are proven clear,
+//         moves halved until each is proven to cut no deeper than depthTolerance (eps); arcs
+//         are kept where proven. The passes stay in their planes (lifting is vertical), and
+//         RasterPass's move counts, the statistics and linkLength describe the lifted path.
+//         The link heights and ways off above were proven for the unlifted ends; lifted, the
+//         ends' vertical rises are proven clear by the envelope itself. gouge.hpp measures
+//         the deepest interference independently.
 // Statistics (PathStats): planes that cut, section components (summed over planes),
-//         contactLength (section polyline lengths), centreLength (the hull paths' true
-//         lengths, arcs as arcs, links excluded); linkLength separately.
+//         contactLength (section polyline lengths), centreLength (the cutting moves' true
+//         lengths, arcs as arcs, links, entries and exits excluded; after lifting when on);
+//         linkLength separately (links, entries and exits).
 // Complexity: one planeSection per plane plus O(vertices) per chain for the hull; a link
 //         costs at most kLinkMaxCells sub-patch subdivisions (typically tens); a pass end,
 //         distance queries: tens when rising straight clears, up to a few thousand when
@@ -104,6 +114,7 @@
 
 #include "scallop/chain.hpp"
 #include "scallop/contour.hpp"
+#include "scallop/envelope.hpp"
 #include "scallop/scallop_hull.hpp"
 #include "scallop/section.hpp"
 #include "scallop/surface.hpp"
@@ -130,6 +141,12 @@ struct RasterOptions {
   double toolRadius = 0.0;  ///< R > 0, surface units
   double chordalTolerance = 0.0;  ///< sections (>= 0); 0 means 1e-4 times surfaceScale
   double arcTolerance = 0.0;  ///< polygonised arcs (>= 0); 0 means the chordal tolerance
+  /// Lift the passes (links, ways on and off included) to the drop envelope (envelope.hpp):
+  /// gouge-free in 3D to depthTolerance. Off: the scallop hull's paths as they are, exact in
+  /// their planes only (they cut into the surface where it rises across the plane).
+  bool dropEnvelope = true;
+  /// eps of the drop envelope (>= 0); 0 means 1e-6 times surfaceScale.
+  double depthTolerance = 0.0;
 };
 
 /// One chain of a plane: what the scallop hull is computed from.
@@ -177,6 +194,8 @@ struct RasterPaths {
   /// Pass ends (entries and exits) for which no candidate way off was proven clear; each
   /// rises straight from the hull path's end (see the contract).
   std::size_t unclearedEnds = 0;
+  /// The drop envelope's lifting (RasterOptions::dropEnvelope; empty when off).
+  EnvelopeReport envelope;
 };
 
 /// The raster paths of `surface` (see the contract). Throws scallop::Error on bad options

@@ -1,0 +1,430 @@
+#include "scallop/envelope.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include <fmt/format.h>
+
+#include "scallop/bezier.hpp"
+#include "scallop/error.hpp"
+
+namespace scallop {
+namespace {
+
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+// Newton iterations of one local maximisation of the drop height, and the seeds tried (the
+// proof's refuting point each time) before bisection takes over.
+constexpr int kNewtonIterations = 30;
+constexpr int kNewtonSeeds = 4;
+
+bool isFinite(Vec3 a) { return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z); }
+
+// g(u, v) = z + sqrt(R^2 - d^2), d the horizontal distance from (x(u, v), y(u, v)) to (X, Y):
+// the height at which the ball centred over (X, Y) touches r(u, v) from above; -infinity
+// where d >= R. Returns g and, when wanted, its gradient and Hessian in (u, v):
+//   A_u = dx x_u + dy y_u,  q = sqrt(R^2 - d^2),
+//   g_u = z_u - A_u / q,
+//   g_uu = z_uu - (x_u^2 + y_u^2 + dx x_uu + dy y_uu) / q - A_u^2 / q^3, likewise g_uv, g_vv.
+struct DropValue {
+  double g = -kInfinity;
+  double gu = 0.0, gv = 0.0, guu = 0.0, guv = 0.0, gvv = 0.0;
+};
+
+DropValue dropValue(const BezierPatch& patch, double u, double v, double X, double Y, double R) {
+  DropValue out;
+  const Vec3 r = point(patch, u, v);
+  const double dx = r.x - X, dy = r.y - Y;
+  const double q2 = R * R - dx * dx - dy * dy;
+  if (!(q2 > 0.0)) return out;
+  const double q = std::sqrt(q2);
+  out.g = r.z + q;
+  const PatchDerivatives d = derivativesToSecondOrder(patch, u, v);
+  const double au = dx * d.u.x + dy * d.u.y;
+  const double av = dx * d.v.x + dy * d.v.y;
+  out.gu = d.u.z - au / q;
+  out.gv = d.v.z - av / q;
+  const double q3 = q2 * q;
+  out.guu = d.uu.z - (d.u.x * d.u.x + d.u.y * d.u.y + dx * d.uu.x + dy * d.uu.y) / q - au * au / q3;
+  out.guv = d.uv.z - (d.u.x * d.v.x + d.u.y * d.v.y + dx * d.uv.x + dy * d.uv.y) / q - au * av / q3;
+  out.gvv = d.vv.z - (d.v.x * d.v.x + d.v.y * d.v.y + dx * d.vv.x + dy * d.vv.y) / q - av * av / q3;
+  return out;
+}
+
+// A local maximum of g on [0, 1]^2 from (u, v): projected Newton (the Hessian when negative
+// definite, else a scaled gradient step), steps clamped to the square and halved until g
+// increases. Its value is a lower bound of the drop envelope (a real contact) or -infinity.
+double localDropHeight(const BezierPatch& patch, double& u, double& v, double X, double Y, double R) {
+  DropValue at = dropValue(patch, u, v, X, Y, R);
+  if (!std::isfinite(at.g)) return -kInfinity;
+  for (int iteration = 0; iteration < kNewtonIterations; ++iteration) {
+    const bool freeU = !((u <= 0.0 && at.gu < 0.0) || (u >= 1.0 && at.gu > 0.0));
+    const bool freeV = !((v <= 0.0 && at.gv < 0.0) || (v >= 1.0 && at.gv > 0.0));
+    double su = 0.0, sv = 0.0;
+    const double det = at.guu * at.gvv - at.guv * at.guv;
+    if (freeU && freeV && at.guu < 0.0 && det > 0.0) {
+      su = -(at.gvv * at.gu - at.guv * at.gv) / det;
+      sv = -(at.guu * at.gv - at.guv * at.gu) / det;
+    } else if (freeU && !freeV && at.guu < 0.0) {
+      su = -at.gu / at.guu;
+    } else if (freeV && !freeU && at.gvv < 0.0) {
+      sv = -at.gv / at.gvv;
+    } else {
+      // Not concave here: a gradient step of at most a tenth of the square.
+      su = freeU ? at.gu : 0.0;
+      sv = freeV ? at.gv : 0.0;
+      const double length = std::hypot(su, sv);
+      if (!(length > 0.0)) break;
+      su *= 0.1 / length;
+      sv *= 0.1 / length;
+    }
+    bool accepted = false;
+    double nu = u, nv = v;
+    for (double lambda = 1.0; lambda > 1e-8; lambda *= 0.5) {
+      nu = std::clamp(u + lambda * su, 0.0, 1.0);
+      nv = std::clamp(v + lambda * sv, 0.0, 1.0);
+      const DropValue trial = dropValue(patch, nu, nv, X, Y, R);
+      if (trial.g > at.g) {
+        at = trial;
+        accepted = true;
+        break;
+      }
+    }
+    if (!accepted) break;
+    const double moved = std::abs(nu - u) + std::abs(nv - v);
+    u = nu;
+    v = nv;
+    if (moved <= 8.0 * std::numeric_limits<double>::epsilon()) break;
+  }
+  return at.g;
+}
+
+// A point of an arc move (from `start`): t in [0, 1] of its sweep.
+struct ArcGeometry {
+  ArcPlane plane = ArcPlane::xy;
+  Vec3 center;     // in the plane's frame (e1, e2, n)
+  double radius = 0.0;
+  double angle0 = 0.0;
+  double sweep = 0.0;  // signed: counter-clockwise positive
+  double n0 = 0.0, n1 = 0.0;
+};
+
+ArcGeometry arcGeometry(Vec3 start, const ToolMove& move) {
+  ArcGeometry arc;
+  arc.plane = move.plane;
+  const Vec3 a = toArcPlane(move.plane, start - move.center);
+  const Vec3 b = toArcPlane(move.plane, move.end - move.center);
+  arc.center = move.center;
+  arc.radius = 0.5 * (std::hypot(a.x, a.y) + std::hypot(b.x, b.y));
+  arc.angle0 = std::atan2(a.y, a.x);
+  double sweep = std::atan2(b.y, b.x) - arc.angle0;
+  const double turn = 2.0 * std::numbers::pi;
+  if (move.clockwise) {
+    while (sweep >= 0.0) sweep -= turn;
+  } else {
+    while (sweep <= 0.0) sweep += turn;
+  }
+  arc.sweep = sweep;
+  arc.n0 = a.z;
+  arc.n1 = b.z;
+  return arc;
+}
+
+Vec3 arcPoint(const ArcGeometry& arc, double t) {
+  const double angle = arc.angle0 + t * arc.sweep;
+  const Vec3 local{arc.radius * std::cos(angle), arc.radius * std::sin(angle),
+                   arc.n0 + t * (arc.n1 - arc.n0)};
+  return arc.center + fromArcPlane(arc.plane, local);
+}
+
+class Lifter {
+ public:
+  Lifter(const SurfaceDistance& distance, double radius, double eps, std::size_t maxCells,
+         EnvelopeReport& report)
+      : distance_(distance), radius_(radius), eps_(eps), maxCells_(maxCells), report_(report) {
+    double top = -kInfinity;
+    for (const BezierPatch& patch : distance.surface().patches) {
+      for (const Vec3& p : patch.control) top = std::max(top, p.z);
+    }
+    // Above every control point by R: every surface point is at least R below, so at least
+    // R away. A relative hair more for the rounding of the comparison.
+    top_ = top + radius * (1.0 + 1e-9) + 1e-9 * std::abs(top);
+  }
+
+  double top() const { return top_; }
+
+  // Whether the ball and its shank over (x, y) from height z up are proven clear by
+  // R - eps / 2; the refuting (or nearest) point is kept as a seed.
+  bool verticalClear(double x, double y, double z) {
+    if (z >= top_) return true;
+    const SegmentClearance test =
+        distance_.segmentClearance({x, y, z}, {x, y, top_}, radius_ - 0.5 * eps_, maxCells_);
+    ++report_.proofs;
+    if (test.verdict != Clearance::proven && std::isfinite(test.distance)) {
+      seedPatch_ = test.patch, seedU_ = test.u, seedV_ = test.v, seeded_ = true;
+    }
+    return test.verdict == Clearance::proven;
+  }
+
+  // The lifted position of p (see the contract).
+  Vec3 lift(Vec3 p) {
+    // Along a path the contact moves little from one vertex to the next: first the local
+    // maximum from the last contact, which settles most vertices with one proof.
+    if (contactKnown_) {
+      const BezierPatch& patch = distance_.surface().patches[contactPatch_];
+      const Contact contact = localDropContact(patch, contactU_, contactV_, p.x, p.y);
+      if (contact.z > p.z && verticalClear(p.x, p.y, contact.z)) {
+        contactU_ = contact.u, contactV_ = contact.v;
+        return {p.x, p.y, contact.z};
+      }
+    }
+    if (verticalClear(p.x, p.y, p.z)) return p;
+    double low = p.z;  // not proven clear
+    // Local maxima of the contact height from the refuting points: each a real contact, so
+    // a lower bound of Z; the first one proven clear is Z itself.
+    for (int seed = 0; seed < kNewtonSeeds && seeded_; ++seed) {
+      seeded_ = false;
+      const std::size_t patchIndex = seedPatch_;
+      const BezierPatch& patch = distance_.surface().patches[patchIndex];
+      const Contact contact = localDropContact(patch, seedU_, seedV_, p.x, p.y);
+      if (!(contact.z > low)) break;
+      low = contact.z;
+      if (verticalClear(p.x, p.y, contact.z)) {
+        contactKnown_ = true;
+        contactPatch_ = patchIndex, contactU_ = contact.u, contactV_ = contact.v;
+        return {p.x, p.y, contact.z};
+      }
+    }
+    // Bisection on the monotone "clear from z up" between low (not proven) and the top.
+    double high = top_;
+    while (high - low > 0.25 * eps_) {
+      const double middle = 0.5 * (low + high);
+      if (verticalClear(p.x, p.y, middle)) {
+        high = middle;
+      } else {
+        low = middle;
+      }
+    }
+    return {p.x, p.y, high};
+  }
+
+  // Whether the straight move [a, b] is proven R - clearanceLoss clear.
+  bool segmentClear(Vec3 a, Vec3 b, double clearanceLoss) {
+    const SegmentClearance test = distance_.segmentClearance(a, b, radius_ - clearanceLoss, maxCells_);
+    ++report_.proofs;
+    if (test.verdict != Clearance::proven && std::isfinite(test.distance)) {
+      seedPatch_ = test.patch, seedU_ = test.u, seedV_ = test.v, seeded_ = true;
+    }
+    return test.verdict == Clearance::proven;
+  }
+
+ private:
+  const SurfaceDistance& distance_;
+  double radius_;
+  double eps_;
+  std::size_t maxCells_;
+  EnvelopeReport& report_;
+  double top_ = 0.0;
+  struct Contact {
+    double z = -kInfinity;
+    double u = 0.0, v = 0.0;
+  };
+  Contact localDropContact(const BezierPatch& patch, double u, double v, double x, double y) const {
+    Contact contact;
+    contact.u = u, contact.v = v;
+    contact.z = localDropHeight(patch, contact.u, contact.v, x, y, radius_);
+    return contact;
+  }
+
+  bool seeded_ = false;
+  std::size_t seedPatch_ = 0;
+  double seedU_ = 0.0, seedV_ = 0.0;
+  bool contactKnown_ = false;  // the last vertex's contact, proven the highest there
+  std::size_t contactPatch_ = 0;
+  double contactU_ = 0.0, contactV_ = 0.0;
+};
+
+// One pass's output: moves and, per output vertex, how far it was lifted.
+struct PassBuilder {
+  std::vector<ToolMove> moves;
+  std::vector<double> lifts;  // of each move's end
+  std::size_t maxMoves = 0;
+  std::size_t* total = nullptr;
+
+  void add(const ToolMove& move, double lift) {
+    if (++*total > maxMoves) {
+      throw Error(fmt::format("lifting the path to the drop envelope: more than {} moves; the "
+                              "depth tolerance is too fine for this path (raise it)",
+                              maxMoves));
+    }
+    moves.push_back(move);
+    lifts.push_back(lift);
+  }
+};
+
+}  // namespace
+
+ToolPath liftToDropEnvelope(const SurfaceDistance& distance, const ToolPath& path,
+                            const EnvelopeOptions& options, EnvelopeReport& report,
+                            std::vector<std::vector<std::size_t>>* moveMap) {
+  const double radius = path.toolRadius;
+  if (!(radius > 0.0) || !std::isfinite(radius)) {
+    throw Error(fmt::format("drop envelope: the tool radius must be positive and finite, got {}", radius));
+  }
+  if (path.units != distance.surface().units) {
+    throw Error(fmt::format("drop envelope: the tool path is in {} but the surface in {}",
+                            unitsName(path.units), unitsName(distance.surface().units)));
+  }
+  const double eps = options.depthTolerance > 0.0 ? options.depthTolerance
+                                                  : 1e-6 * surfaceScale(distance.surface());
+  if (!(eps > 0.0) || !std::isfinite(eps) || options.depthTolerance < 0.0) {
+    throw Error(fmt::format("drop envelope: the depth tolerance must be positive and finite, got {}",
+                            options.depthTolerance));
+  }
+  if (!(eps < radius)) {
+    throw Error(fmt::format("drop envelope: the depth tolerance {} must be below the tool radius {}", eps, radius));
+  }
+  if (!(options.stretchThreshold >= 0.0) || !std::isfinite(options.stretchThreshold)) {
+    throw Error(fmt::format("drop envelope: the stretch threshold must be finite and >= 0, got {}",
+                            options.stretchThreshold));
+  }
+  if (options.maxMoves < 1 || options.maxCellsPerProof < 1) {
+    throw Error("drop envelope: the budgets must be at least 1");
+  }
+  report = EnvelopeReport{};
+  report.depthTolerance = eps;
+  report.stretchThreshold = options.stretchThreshold > 0.0 ? options.stretchThreshold : 10.0 * eps;
+  Lifter lifter(distance, radius, eps, options.maxCellsPerProof, report);
+  ToolPath out;
+  out.units = path.units;
+  out.toolRadius = radius;
+  std::size_t total = 0;
+  if (moveMap) moveMap->assign(path.passes.size(), {});
+
+  for (std::size_t passIndex = 0; passIndex < path.passes.size(); ++passIndex) {
+    const ToolPass& pass = path.passes[passIndex];
+    if (!isFinite(pass.start)) {
+      throw Error(fmt::format("drop envelope: pass {}: the start is not finite", passIndex));
+    }
+    PassBuilder builder;
+    builder.maxMoves = options.maxMoves;
+    builder.total = &total;
+    ToolPass lifted;
+    lifted.retractBefore = pass.retractBefore;
+    // A pass fed from the previous one's end starts where that end was lifted to.
+    const bool continued = !pass.retractBefore && passIndex > 0 &&
+                           !path.passes[passIndex - 1].moves.empty() &&
+                           path.passes[passIndex - 1].moves.back().end == pass.start &&
+                           !out.passes.back().moves.empty();
+    lifted.start = continued ? out.passes.back().moves.back().end : lifter.lift(pass.start);
+    const double startLift = lifted.start.z - pass.start.z;
+
+    // Straight moves from `from` (already lifted) to `to` (lifted): proven, or halved with
+    // the midpoint lifted, depth first so the moves come out in order.
+    auto refineLine = [&](auto&& self, Vec3 from, Vec3 to, double toLift, int halvings) -> void {
+      if (lifter.segmentClear(from, to, eps)) {
+        builder.add(ToolMove{MoveKind::line, to, {}, ArcPlane::xy, true}, toLift);
+        return;
+      }
+      if (halvings >= kEnvelopeMaxHalvings || !(norm(to - from) > 0.25 * eps)) {
+        ++report.unprovenMoves;
+        builder.add(ToolMove{MoveKind::line, to, {}, ArcPlane::xy, true}, toLift);
+        return;
+      }
+      const Vec3 middle = 0.5 * (from + to);
+      const Vec3 raised = lifter.lift(middle);
+      self(self, from, raised, raised.z - middle.z, halvings + 1);
+      self(self, raised, to, toLift, halvings + 1);
+    };
+
+    Vec3 at = pass.start;       // the input position
+    Vec3 liftedAt = lifted.start;
+    for (std::size_t m = 0; m < pass.moves.size(); ++m) {
+      const ToolMove& move = pass.moves[m];
+      if (!isFinite(move.end) || (move.kind == MoveKind::arc && !isFinite(move.center))) {
+        throw Error(fmt::format("drop envelope: pass {}, move {}: not finite", passIndex, m));
+      }
+      ++report.movesIn;
+      const Vec3 end = lifter.lift(move.end);
+      const double endLift = end.z - move.end.z;
+      if (move.kind == MoveKind::line) {
+        refineLine(refineLine, liftedAt, end, endLift, 0);
+      } else {
+        const ArcGeometry arc = arcGeometry(at, move);
+        // Chords of sagitta <= eps / 4: k = ceil(|sweep| / (2 acos(1 - s / r))).
+        const double sagitta = 0.25 * eps;
+        const double step = 2.0 * std::acos(std::max(-1.0, 1.0 - sagitta / std::max(arc.radius, sagitta)));
+        const double pieces = std::ceil(std::abs(arc.sweep) / step);
+        if (!(pieces <= 1e6)) {
+          throw Error(fmt::format("drop envelope: pass {}, move {}: an arc of radius {} needs more "
+                                  "than a million chords at depth tolerance {}", passIndex, m, arc.radius, eps));
+        }
+        const auto count = static_cast<std::size_t>(std::max(1.0, pieces));
+        bool keep = liftedAt == at && end == move.end;
+        // Each chord's sagitta, exactly: r (1 - cos(sweep / 2k)).
+        const double chordSagitta = arc.radius * (1.0 - std::cos(0.5 * std::abs(arc.sweep) / static_cast<double>(count)));
+        for (std::size_t i = 0; keep && i < count; ++i) {
+          const Vec3 a = i == 0 ? at : arcPoint(arc, static_cast<double>(i) / static_cast<double>(count));
+          const Vec3 b = i + 1 == count ? move.end : arcPoint(arc, static_cast<double>(i + 1) / static_cast<double>(count));
+          keep = lifter.segmentClear(a, b, eps - chordSagitta);
+        }
+        if (keep) {
+          ++report.arcsKept;
+          builder.add(move, 0.0);
+        } else {
+          ++report.arcsReplaced;
+          // Points of the arc a chord apart, each lifted, then refined as lines.
+          Vec3 from = liftedAt;
+          for (std::size_t i = 1; i <= count; ++i) {
+            const Vec3 onArc = i == count ? move.end : arcPoint(arc, static_cast<double>(i) / static_cast<double>(count));
+            const Vec3 raised = i == count ? end : lifter.lift(onArc);
+            refineLine(refineLine, from, raised, raised.z - onArc.z, 0);
+            from = raised;
+          }
+        }
+      }
+      if (moveMap) (*moveMap)[passIndex].push_back(builder.moves.size());
+      at = move.end;
+      liftedAt = end;
+    }
+    lifted.moves = std::move(builder.moves);
+    report.movesOut += lifted.moves.size();
+
+    // Lifted vertices and stretches.
+    const double threshold = report.stretchThreshold;
+    std::vector<double> lifts;
+    lifts.push_back(startLift);
+    lifts.insert(lifts.end(), builder.lifts.begin(), builder.lifts.end());
+    auto vertex = [&](std::size_t i) { return i == 0 ? lifted.start : lifted.moves[i - 1].end; };
+    std::size_t i = 0;
+    while (i < lifts.size()) {
+      report.maxLift = std::max(report.maxLift, lifts[i]);
+      if (lifts[i] > eps) ++report.verticesLifted;
+      if (!(lifts[i] > threshold)) {
+        ++i;
+        continue;
+      }
+      LiftedStretch stretch;
+      stretch.pass = passIndex;
+      stretch.from = vertex(i);
+      std::size_t j = i;
+      while (j + 1 < lifts.size() && lifts[j + 1] > threshold) {
+        ++j;
+        stretch.length += norm(vertex(j) - vertex(j - 1));
+        report.maxLift = std::max(report.maxLift, lifts[j]);
+        if (lifts[j] > eps) ++report.verticesLifted;
+      }
+      for (std::size_t k = i; k <= j; ++k) stretch.maxLift = std::max(stretch.maxLift, lifts[k]);
+      stretch.to = vertex(j);
+      report.liftedLength += stretch.length;
+      report.stretches.push_back(stretch);
+      i = j + 1;
+    }
+    out.passes.push_back(std::move(lifted));
+  }
+  return out;
+}
+
+}  // namespace scallop
