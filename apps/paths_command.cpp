@@ -127,7 +127,7 @@ void addPathsCommand(CLI::App& app) {
   paths->add_option("--gcode", options->gcodePath, "write the G-code program")->type_name("OUT");
   paths->add_option("--svg", options->svgPath, "write a picture of the surface, the sections and the paths")
       ->type_name("OUT");
-  paths->add_flag("--no-gouge-check", options->noGougeCheck, "raster: skip the ball-against-surface check");
+  paths->add_flag("--no-gouge-check", options->noGougeCheck, "skip the sampled ball-against-surface check (the drop envelope's proof stays)");
   paths->callback([options] { runPaths(*options); });
 }
 

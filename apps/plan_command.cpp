@@ -100,8 +100,12 @@ void runPlan(const PlanOptions& options) {
   writeOutputs(outputs, options.out);
   const PathStats& s = report.stats;
   std::string gouge;
+  if (report.envelope && report.envelope->verticesLifted > 0)
+    gouge += fmt::format(", lifted to the drop envelope (eps {:.2g}) by up to {:.6f} {} over {} "
+                         "stretches", report.envelope->depthTolerance, report.envelope->maxLift,
+                         unitsName(surface.units), report.envelope->stretches.size());
   if (report.gouge)
-    gouge = fmt::format(", deepest ball interference {:.6f} {} (bound {:.6f})", report.gouge->maxDepth,
+    gouge += fmt::format(", deepest ball interference {:.6f} {} (bound {:.6f})", report.gouge->maxDepth,
                         unitsName(surface.units), report.gouge->depthBound);
   fmt::print(stderr,
              "scallop plan: {} on {}: N* = ({:.4f}, {:.4f}, {:.4f}), alpha* = {:.3f} deg; spacing "

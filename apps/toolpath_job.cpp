@@ -31,6 +31,16 @@ std::vector<Vec3> curvePoints(const SectionCurve& curve) {
   return points;
 }
 
+// The ball against the whole surface, sampled every R / 10 along the path (the bound
+// between samples adds R / 20): an independent measure beside the envelope's proof.
+void checkGouge(const Surface& surface, const JobOptions& options, JobResult& result,
+                const Progress& progress) {
+  const double spacing = options.toolRadius / 10.0;
+  say(progress, fmt::format("checking the ball against the whole surface every {:.6g}", spacing));
+  result.report.gouge = gougeCheck(surface, result.path, spacing);
+  result.report.gougeSampleSpacing = spacing;
+}
+
 void runContour(const Surface& surface, const JobOptions& options, JobResult& result,
                 const Progress& progress) {
   Vec3 normal;
@@ -66,6 +76,7 @@ void runContour(const Surface& surface, const JobOptions& options, JobResult& re
   ContourOptions contour;
   contour.normal = normal;
   contour.toolRadius = options.toolRadius;
+  if (options.scallopHeight) contour.stretchThreshold = *options.scallopHeight;
   contour.spacing = options.spacing ? *options.spacing
                                     : spacingForScallopHeight(options.toolRadius,
                                                               *options.scallopHeight, alpha);
@@ -75,16 +86,19 @@ void runContour(const Surface& surface, const JobOptions& options, JobResult& re
   result.report.planeNormal = paths.normal;
   result.report.alphaRad = alpha;
   result.report.stats = paths.stats;
+  result.report.envelope = paths.envelope;
   for (const ContourSection& section : paths.sections)
     for (const SectionCurve& curve : section.section.curves)
       result.contactCurves.push_back(curvePoints(curve));
   result.path = std::move(paths.path);
+  if (options.gougeCheck) checkGouge(surface, options, result, progress);
 }
 
 void runRaster(const Surface& surface, const JobOptions& options, JobResult& result,
                const Progress& progress) {
   RasterOptions raster;
   raster.toolRadius = options.toolRadius;
+  if (options.scallopHeight) raster.stretchThreshold = *options.scallopHeight;
   if (options.angleDeg) {
     raster.angleRad = *options.angleDeg * kDeg;
   } else {
@@ -105,14 +119,9 @@ void runRaster(const Surface& surface, const JobOptions& options, JobResult& res
   for (const RasterSection& section : paths.sections)
     for (const SectionCurve& curve : section.section.curves)
       result.contactCurves.push_back(curvePoints(curve));
+  result.report.envelope = paths.envelope;
   result.path = std::move(paths.path);
-  if (options.gougeCheck) {
-    // Samples every R / 10 along the path: the bound between samples adds R / 20.
-    const double spacing = options.toolRadius / 10.0;
-    say(progress, fmt::format("checking the ball against the whole surface every {:.6g}", spacing));
-    result.report.gouge = gougeCheck(surface, result.path, spacing);
-    result.report.gougeSampleSpacing = spacing;
-  }
+  if (options.gougeCheck) checkGouge(surface, options, result, progress);
 }
 
 }  // namespace

@@ -23,7 +23,7 @@ struct JobOptions {
   std::optional<double> scallopHeight;  ///< H (0 < H < R): Delta from H and alpha
   std::optional<Vec3> normal;           ///< contour: N; none = the optimal N* (orient)
   std::optional<double> angleDeg;       ///< raster: feed angle; none = the best angle
-  bool gougeCheck = true;               ///< raster: measure the ball's interference
+  bool gougeCheck = true;               ///< measure the ball's interference (gouge.hpp)
 };
 
 struct JobResult {

@@ -9,6 +9,7 @@
 
 #include "scallop/bezier.hpp"
 #include "scallop/error.hpp"
+#include "scallop/gouge.hpp"
 #include "scallop/optimal_slicing.hpp"
 #include "alignment.hpp"
 
@@ -25,15 +26,14 @@ double alignment(const BezierPatch& patch, const Vec3& m, double u, double v) {
   return std::abs(dot(unitNormal(patch, u, v), m));
 }
 
-// One orientation per patch, the one whose normal at the parameter centre points up, so
-// that the offset does not flip side where the surface is steep: +1 or -1 times r_u x r_v.
-double upwardSign(const BezierPatch& patch) { return unitNormal(patch, 0.5, 0.5).z >= 0.0 ? 1.0 : -1.0; }
-
 }  // namespace
 
+// Per point, not per patch: a patch that folds over (a wall, an undercut) has both sides
+// facing up somewhere, and the ball from above can only touch the upper one. Where the
+// normal turns down the offset is inside the material and the drop envelope lifts it out.
 Vec3 upwardNormal(const Surface& surface, std::size_t patch, double u, double v) {
-  const BezierPatch& p = surface.patches.at(patch);
-  return upwardSign(p) * unitNormal(p, u, v);
+  const Vec3 n = unitNormal(surface.patches.at(patch), u, v);
+  return n.z < 0.0 ? -n : n;
 }
 
 double spacingForScallopHeight(double toolRadius, double scallopHeight, double alphaRad) {
@@ -123,6 +123,8 @@ ContourPaths contourPaths(const Surface& surface, const ContourOptions& options)
                             options.normal.x, options.normal.y, options.normal.z));
   requirePositive("the plane spacing", options.spacing);
   requirePositive("the tool radius", options.toolRadius);
+  if (!(options.depthTolerance >= 0.0) || !std::isfinite(options.depthTolerance))
+    throw Error(fmt::format("the depth tolerance must be a finite number >= 0, got {}", options.depthTolerance));
   const double scale = surfaceScale(surface);
   const double tolerance =
       options.chordalTolerance > 0.0 ? options.chordalTolerance : 1e-4 * std::max(scale, 1e-300);
@@ -134,8 +136,6 @@ ContourPaths contourPaths(const Surface& surface, const ContourOptions& options)
   out.path.units = surface.units;
   out.path.toolRadius = options.toolRadius;
   const PlaneRange range = planeRange(surface, out.normal, options.spacing, "the plane spacing");
-  std::vector<double> up;  // upwardSign per patch, once rather than per vertex
-  for (const BezierPatch& patch : surface.patches) up.push_back(upwardSign(patch));
   for (double kk = range.first; kk <= range.last; kk += 1.0) {
     const long long k = static_cast<long long>(kk);
     const double offset = kk * options.spacing;
@@ -150,7 +150,7 @@ ContourPaths contourPaths(const Surface& surface, const ContourOptions& options)
       bool atStart = true;
       Vec3 previous;
       for (const SectionPoint& p : curve.points) {
-        const Vec3 normal = up[p.patch] * unitNormal(surface.patches[p.patch], p.u, p.v);
+        const Vec3 normal = upwardNormal(surface, p.patch, p.u, p.v);
         const Vec3 centre = p.point + options.toolRadius * normal;
         if (atStart) {
           pass.start = centre;
@@ -169,6 +169,17 @@ ContourPaths contourPaths(const Surface& surface, const ContourOptions& options)
     throw Error(fmt::format(
         "no plane N . r = k * {} with N = ({}, {}, {}) cuts the surface (N . r spans [{}, {}])",
         options.spacing, out.normal.x, out.normal.y, out.normal.z, range.lo, range.hi));
+  if (options.dropEnvelope) {
+    EnvelopeOptions envelope;
+    envelope.depthTolerance = options.depthTolerance;
+    envelope.stretchThreshold = options.stretchThreshold;
+    out.path = liftToDropEnvelope(SurfaceDistance(surface), out.path, envelope, out.envelope);
+    out.stats.centreLength = 0.0;
+    for (const ToolPass& pass : out.path.passes) {
+      Vec3 at = pass.start;
+      for (const ToolMove& move : pass.moves) out.stats.centreLength += norm(move.end - at), at = move.end;
+    }
+  }
   return out;
 }
 

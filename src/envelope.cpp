@@ -20,6 +20,9 @@ constexpr double kInfinity = std::numeric_limits<double>::infinity();
 constexpr int kNewtonIterations = 30;
 constexpr int kNewtonSeeds = 4;
 
+// The lift recorded for a vertex inserted by halving (see the stretches below).
+constexpr double kInserted = -std::numeric_limits<double>::infinity();
+
 bool isFinite(Vec3 a) { return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z); }
 
 // g(u, v) = z + sqrt(R^2 - d^2), d the horizontal distance from (x(u, v), y(u, v)) to (X, Y):
@@ -335,7 +338,7 @@ ToolPath liftToDropEnvelope(const SurfaceDistance& distance, const ToolPath& pat
       }
       const Vec3 middle = 0.5 * (from + to);
       const Vec3 raised = lifter.lift(middle);
-      self(self, from, raised, raised.z - middle.z, halvings + 1);
+      self(self, from, raised, kInserted, halvings + 1);
       self(self, raised, to, toLift, halvings + 1);
     };
 
@@ -380,7 +383,7 @@ ToolPath liftToDropEnvelope(const SurfaceDistance& distance, const ToolPath& pat
           for (std::size_t i = 1; i <= count; ++i) {
             const Vec3 onArc = i == count ? move.end : arcPoint(arc, static_cast<double>(i) / static_cast<double>(count));
             const Vec3 raised = i == count ? end : lifter.lift(onArc);
-            refineLine(refineLine, from, raised, raised.z - onArc.z, 0);
+            refineLine(refineLine, from, raised, i == count ? endLift : raised.z - onArc.z, 0);
             from = raised;
           }
         }
@@ -397,6 +400,25 @@ ToolPath liftToDropEnvelope(const SurfaceDistance& distance, const ToolPath& pat
     std::vector<double> lifts;
     lifts.push_back(startLift);
     lifts.insert(lifts.end(), builder.lifts.begin(), builder.lifts.end());
+    // An inserted vertex (a halving's midpoint) has no input point below it: the lift of a
+    // chord's midpoint is its sag, not the surface's doing. It counts as lifted as much as the
+    // lesser of the input vertices around it.
+    {
+      double before = 0.0;
+      std::vector<double> after(lifts.size(), 0.0);
+      double next = 0.0;
+      for (std::size_t k = lifts.size(); k-- > 0;) {
+        if (lifts[k] != kInserted) next = lifts[k];
+        after[k] = next;
+      }
+      for (std::size_t k = 0; k < lifts.size(); ++k) {
+        if (lifts[k] != kInserted) {
+          before = lifts[k];
+        } else {
+          lifts[k] = std::min(before, after[k]);
+        }
+      }
+    }
     auto vertex = [&](std::size_t i) { return i == 0 ? lifted.start : lifted.moves[i - 1].end; };
     std::size_t i = 0;
     while (i < lifts.size()) {

@@ -129,6 +129,35 @@ std::string pathsToJson(const PathsReport& report, const ToolPath& path) {
   if (report.linkLength) stats["link_length"] = *report.linkLength;
   if (report.unclearedEnds) stats["uncleared_ends"] = *report.unclearedEnds;
   document["stats"] = stats;
+  if (report.envelope) {
+    const EnvelopeReport& e = *report.envelope;
+    Json envelope;
+    envelope["depth_tolerance"] = e.depthTolerance;
+    envelope["vertices_lifted"] = e.verticesLifted;
+    envelope["max_lift"] = e.maxLift;
+    envelope["lifted_length"] = e.liftedLength;
+    envelope["moves_in"] = e.movesIn;
+    envelope["moves_out"] = e.movesOut;
+    envelope["arcs_kept"] = e.arcsKept;
+    envelope["arcs_replaced"] = e.arcsReplaced;
+    envelope["proofs"] = e.proofs;
+    envelope["unproven_moves"] = e.unprovenMoves;
+    envelope["stretch_threshold"] = e.stretchThreshold;
+    Json stretches = Json::array();
+    for (const LiftedStretch& stretch : e.stretches) {
+      Json item;
+      item["pass"] = stretch.pass;
+      item["from"] = vec(stretch.from);
+      item["to"] = vec(stretch.to);
+      item["length"] = stretch.length;
+      item["max_lift"] = stretch.maxLift;
+      stretches.push_back(std::move(item));
+    }
+    envelope["lifted_stretches"] = std::move(stretches);
+    document["envelope"] = std::move(envelope);
+  } else {
+    document["envelope"] = nullptr;
+  }
   if (report.gouge) {
     Json gouge;
     gouge["max_depth"] = report.gouge->maxDepth;

@@ -551,9 +551,10 @@ double moveLength(Vec3 from, const ToolMove& move) {
 
 // The passes lifted to the drop envelope; the move counts of RasterPass and the lengths
 // recomputed on the lifted moves.
-void liftRasterPaths(const SurfaceDistance& distance, double depthTolerance, RasterPaths& out) {
+void liftRasterPaths(const SurfaceDistance& distance, const RasterOptions& options, RasterPaths& out) {
   EnvelopeOptions envelope;
-  envelope.depthTolerance = depthTolerance;
+  envelope.depthTolerance = options.depthTolerance;
+  envelope.stretchThreshold = options.stretchThreshold;
   std::vector<std::vector<std::size_t>> moveMap;
   out.path = liftToDropEnvelope(distance, out.path, envelope, out.envelope, &moveMap);
   out.stats.centreLength = 0.0;
@@ -708,7 +709,7 @@ RasterPaths rasterPaths(const Surface& surface, const RasterOptions& options) {
     throw Error(fmt::format(
         "no plane e . r = k * {} with e = ({}, {}, 0) cuts the surface (e . r spans [{}, {}])",
         out.spacing, frame.e.x, frame.e.y, range.lo, range.hi));
-  if (options.dropEnvelope) liftRasterPaths(distance, options.depthTolerance, out);
+  if (options.dropEnvelope) liftRasterPaths(distance, options, out);
   return out;
 }
 

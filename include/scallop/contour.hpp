@@ -6,17 +6,22 @@
 //
 // Contract
 // --------
-// Input:  a valid surface (surface.hpp) to be cut from above (z up): each patch is oriented
-//         so that its normal at the parameter centre points up (n_z >= 0); a plane normal N
+// Input:  a valid surface (surface.hpp) to be cut from above (z up); a plane normal N
 //         (finite, non-zero; normalised); a spacing Delta > 0 between planes; a ball radius
 //         R > 0; a chordal tolerance (surface units) for the traced sections.
 // Output: every plane N . r = k Delta that cuts the surface (k from the control points'
 //         extent, so no plane is missed), its section (section.hpp), and one tool pass per
 //         section curve through the centres r + R n at the curve's vertices (n the unit
-//         normal at the vertex's (u, v), oriented as above); passes follow the planes in
-//         increasing k, each entered from the safe height. Statistics: planes that cut,
-//         connected components (summed over planes), the contact-locus length and the
-//         tool-centre path length (polyline lengths).
+//         normal at the vertex's (u, v), turned up at each point: n_z >= 0, the side a ball
+//         from above reaches); passes follow the planes in increasing k, each entered from
+//         the safe height. By default (dropEnvelope) each pass is then lifted to the drop
+//         envelope (envelope.hpp): a centre that would cut in (a concave radius below R, a
+//         crease, another part of the surface within R, a chord sagging below the offset)
+//         rises straight up to the lowest position proven clear, and every move is proven to
+//         cut no deeper than depthTolerance; the lifted stretches are reported.
+//         Statistics: planes that cut, connected components (summed over planes), the
+//         contact-locus length and the tool-centre path length (polyline lengths, after
+//         lifting).
 // Scallop height: planes Delta apart meet the surface in curves whose local distance on the
 //         surface is l = Delta / sqrt(1 - (N . n)^2) = Delta / sin(angle(N, n)); the ball
 //         leaves a cusp of height h = R - sqrt(R^2 - l^2 / 4) between neighbouring passes
@@ -30,6 +35,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "scallop/envelope.hpp"
 #include "scallop/section.hpp"
 #include "scallop/surface.hpp"
 #include "scallop/toolpath.hpp"
@@ -42,6 +48,15 @@ struct ContourOptions {
   double spacing = 0.0;         ///< Delta > 0, surface units
   double toolRadius = 0.0;      ///< R > 0, surface units
   double chordalTolerance = 0.0;  ///< > 0; 0 means 1e-4 times the surface's largest coordinate
+  /// Lift the passes to the drop envelope (envelope.hpp): gouge-free in 3D to
+  /// depthTolerance. Off: the centres r + R n as they are (they cut in where a concave
+  /// radius is below R, at creases, where another part of the surface comes within R, and
+  /// where a straight move sags below the true offset curve).
+  bool dropEnvelope = true;
+  /// eps of the drop envelope (>= 0); 0 means 1e-6 times surfaceScale.
+  double depthTolerance = 0.0;  /// Lifts above this are reported as stretches the ball cannot follow (>= 0); 0 means
+  /// the envelope's default (10 eps). The CLI passes the scallop height.
+  double stretchThreshold = 0.0;
 };
 
 struct PathStats {
@@ -64,6 +79,10 @@ struct ContourPaths {
   std::vector<ContourSection> sections;  ///< the planes that cut, in increasing k
   ToolPath path;   ///< one pass per section curve, same order
   PathStats stats;
+  /// The drop envelope's lifting (ContourOptions::dropEnvelope; empty when off): its
+  /// lifted stretches are where the ball as given cannot follow the surface (areas left for
+  /// a smaller tool).
+  EnvelopeReport envelope;
 };
 
 /// The contour paths of `surface` (see the contract); throws scallop::Error on bad options.
@@ -89,7 +108,8 @@ PlaneRange planeRange(const Surface& surface, const Vec3& unitNormal, double spa
 /// Throws scallop::Error unless 0 < H < R and 0 < alpha <= pi / 2.
 double spacingForScallopHeight(double toolRadius, double scallopHeight, double alphaRad);
 
-/// The unit normal at (u, v) of patch `patch`, oriented up as the contract says.
+/// The unit normal at (u, v) of patch `patch`, turned up (n_z >= 0; a horizontal normal keeps
+/// the patch's r_u x r_v orientation).
 Vec3 upwardNormal(const Surface& surface, std::size_t patch, double u, double v);
 
 /// The smallest angle (radians) between `direction` and +-(surface normals), with a proof:

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "scallop/contour.hpp"
+#include "scallop/envelope.hpp"
 #include "scallop/gouge.hpp"
 #include "scallop/surface.hpp"
 #include "scallop/toolpath.hpp"
@@ -49,7 +50,9 @@ struct PathsReport {
   std::optional<double> linkLength;
   std::optional<std::size_t> unclearedEnds;
   PathStats stats;
-  std::optional<GougeReport> gouge;  ///< raster: the ball against the whole surface
+  /// The drop envelope's lifting (envelope.hpp), when the strategy lifted its passes.
+  std::optional<EnvelopeReport> envelope;
+  std::optional<GougeReport> gouge;  ///< the ball against the whole surface, sampled
   double gougeSampleSpacing = 0.0;   ///< the spacing the gouge check sampled at
   std::optional<OrientationSummary> orientation;
   double seconds = 0.0;

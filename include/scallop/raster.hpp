@@ -146,7 +146,9 @@ struct RasterOptions {
   /// their planes only (they cut into the surface where it rises across the plane).
   bool dropEnvelope = true;
   /// eps of the drop envelope (>= 0); 0 means 1e-6 times surfaceScale.
-  double depthTolerance = 0.0;
+  double depthTolerance = 0.0;  /// Lifts above this are reported as stretches the ball cannot follow (>= 0); 0 means
+  /// the envelope's default (10 eps). The CLI passes the scallop height.
+  double stretchThreshold = 0.0;
 };
 
 /// One chain of a plane: what the scallop hull is computed from.
