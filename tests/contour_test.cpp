@@ -45,6 +45,7 @@ TEST(Contour, ReproducesTable1) {
     options.normal = row.normal;
     options.spacing = row.spacing;
     options.toolRadius = 0.25;
+    options.dropEnvelope = false;  // the paper's paths: r + R n, unlifted
     const auto result = scallop::contourPaths(scallop::exampleSurface(row.surface), options);
     EXPECT_NEAR(result.stats.centreLength, row.paperLength, 0.01 * row.paperLength) << row.surface;
     EXPECT_LE(std::abs(double(result.stats.components) - double(row.paperComponents)), 3.0)
@@ -61,6 +62,7 @@ TEST(Contour, CentresAndPlanes) {
   options.normal = {0.3, -0.9, 0.2};
   options.spacing = 0.05;
   options.toolRadius = 0.25;
+  options.dropEnvelope = false;  // the centres r + R n themselves (lifting: envelope_test.cpp)
   const auto result = scallop::contourPaths(s, options);
   const Vec3 n = scallop::normalized(options.normal);
   double lo = 1e9, hi = -1e9;
