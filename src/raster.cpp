@@ -171,6 +171,89 @@ std::vector<RasterChain> planeChains(const PlaneSection& section, const Frame& f
   return chains;
 }
 
+// The plane's chains when the surface is not a graph over the raster direction (a closed
+// section, one that turns back, sheets over one another): what a ball from above can see of
+// it, the upper envelope of its curves over s, as chains. The envelope is taken at every
+// vertex's s (its crossings of two curves in between are cut a little low: the drop envelope
+// lifts the path there, see the contract); curves whose s ranges overlap form one chain, and
+// chains less than 2R apart are bridged as planeChains does.
+std::vector<RasterChain> visibleChains(const PlaneSection& section, const Frame& f, double radius) {
+  struct Piece {
+    double lo, hi;
+    std::vector<Point2> points;  // (s, z) along the curve, closed curves closed
+    std::size_t curve;
+  };
+  std::vector<Piece> pieces;
+  for (std::size_t i = 0; i < section.curves.size(); ++i) {
+    const SectionCurve& curve = section.curves[i];
+    if (curve.points.size() < 2) continue;
+    Piece piece{kInf, -kInf, {}, i};
+    for (const SectionPoint& p : curve.points) {
+      piece.points.push_back({dot(f.d, p.point), p.point.z});
+      piece.lo = std::min(piece.lo, piece.points.back().x);
+      piece.hi = std::max(piece.hi, piece.points.back().x);
+    }
+    if (curve.closed) piece.points.push_back(piece.points.front());
+    pieces.push_back(std::move(piece));
+  }
+  std::sort(pieces.begin(), pieces.end(), [](const Piece& a, const Piece& b) { return a.lo < b.lo; });
+  std::vector<RasterChain> chains;
+  for (std::size_t first = 0; first < pieces.size();) {
+    // A run of pieces whose s ranges overlap: one stretch of the envelope.
+    std::size_t last = first;
+    double reach = pieces[first].hi;
+    while (last + 1 < pieces.size() && pieces[last + 1].lo <= reach) reach = std::max(reach, pieces[++last].hi);
+    std::vector<double> stations;
+    std::size_t work = 0;
+    for (std::size_t k = first; k <= last; ++k) {
+      for (const Point2& p : pieces[k].points) stations.push_back(p.x);
+      work += pieces[k].points.size();
+    }
+    std::sort(stations.begin(), stations.end());
+    stations.erase(std::unique(stations.begin(), stations.end()), stations.end());
+    if (static_cast<double>(stations.size()) * static_cast<double>(work) > 5e7) {
+      throw Error(fmt::format("the section at plane offset {} has {} vertices over one stretch: "
+                              "too many for its upper envelope (use a coarser chordal tolerance)",
+                              dot(f.e, section.curves[pieces[first].curve].points.front().point),
+                              stations.size()));
+    }
+    Chain chain;
+    for (const double station : stations) {
+      double top = -kInf;
+      for (std::size_t k = first; k <= last; ++k) {
+        const std::vector<Point2>& pts = pieces[k].points;
+        for (std::size_t i = 0; i + 1 < pts.size(); ++i) {
+          const Point2 a = pts[i], b = pts[i + 1];
+          if (station < std::min(a.x, b.x) || station > std::max(a.x, b.x)) continue;
+          if (a.x == b.x) {
+            top = std::max({top, a.z, b.z});
+          } else {
+            const double t = (station - a.x) / (b.x - a.x);
+            top = std::max(top, a.z + t * (b.z - a.z));
+          }
+        }
+      }
+      chain.push_back({station, top});
+    }
+    if (chain.size() >= 2) {
+      if (!chains.empty() && chain.front().x - chains.back().chain.back().x < 2.0 * radius) {
+        Chain& previous = chains.back().chain;
+        const Point2 a = previous.back();
+        const double floor = std::min(a.z, chain.front().z) - 2.0 * radius;
+        previous.push_back({a.x, floor});
+        previous.push_back({chain.front().x, floor});
+        previous.insert(previous.end(), chain.begin(), chain.end());
+      } else {
+        chains.push_back({});
+        chains.back().chain = std::move(chain);
+      }
+      for (std::size_t k = first; k <= last; ++k) chains.back().curves.push_back(pieces[k].curve);
+    }
+    first = last + 1;
+  }
+  return chains;
+}
+
 // ---------------------------------------------------------------------------------------
 // Passes
 // ---------------------------------------------------------------------------------------
@@ -640,7 +723,17 @@ RasterPaths rasterPaths(const Surface& surface, const RasterOptions& options) {
     RasterSection plane;
     plane.offset = w;
     plane.k = static_cast<long long>(kk);
-    plane.chains = planeChains(section, frame, w, radius, tau);
+    if (options.dropEnvelope) {
+      // Not a graph here: the part a ball from above sees (the error names where otherwise).
+      try {
+        plane.chains = planeChains(section, frame, w, radius, tau);
+      } catch (const Error&) {
+        plane.chains = visibleChains(section, frame, radius);
+        ++out.visibleFromAbovePlanes;
+      }
+    } else {
+      plane.chains = planeChains(section, frame, w, radius, tau);
+    }
     if (plane.chains.empty()) continue;
     plane.reversed = out.sections.size() % 2 == 1;
     ++out.stats.planes;

@@ -23,11 +23,14 @@
 //         in increasing k. A plane whose section has no curve of two or more points
 //         (it misses the surface, or only touches it) is skipped.
 // Chains: each section curve, as (s, z) at its vertices, must be monotone in s; it is
-//         oriented so that s increases. The surface must be a graph over the raster
-//         direction: a closed section, a curve whose s turns back by more than
+//         oriented so that s increases. Where the surface is not a graph over the raster
+//         direction (a closed section, a curve whose s turns back by more than
 //         tau = 1e-9 surfaceScale, or two curves of one plane whose s ranges overlap by more
-//         than tau (one sheet above another) throw scallop::Error naming the plane offset
-//         w, the patch, (u, v) and the point. Back-steps within tau are flattened (s set to
+//         than tau: one sheet above another), with dropEnvelope the plane's chain is what a
+//         ball from above sees: the upper envelope over s of its curves, taken at every
+//         vertex's s (a crossing of two curves between stations is cut low; the drop
+//         envelope lifts the path there), counted in visibleFromAbovePlanes; without it,
+//         scallop::Error names the plane offset w, the patch, (u, v) and the point. Back-steps within tau are flattened (s set to
 //         the running maximum). Curves of one plane whose s gap g is >= 2R are separate
 //         chains, one pass each; curves closer than 2R are merged into one chain through two
 //         bridge vertices (s_a, zb), (s_b, zb), zb = min(z_a, z_b) - 2R, at the gap's ends:
@@ -198,11 +201,14 @@ struct RasterPaths {
   std::size_t unclearedEnds = 0;
   /// The drop envelope's lifting (RasterOptions::dropEnvelope; empty when off).
   EnvelopeReport envelope;
+  /// Planes where the surface is not a graph over the raster direction, cut along the upper
+  /// envelope of their sections (with dropEnvelope; see the contract).
+  std::size_t visibleFromAbovePlanes = 0;
 };
 
 /// The raster paths of `surface` (see the contract). Throws scallop::Error on bad options
-/// (naming the value), a surface that is not a graph over the raster direction (naming
-/// where), or when no plane cuts the surface.
+/// (naming the value), without dropEnvelope a surface that is not a graph over the raster
+/// direction (naming where), or when no plane cuts the surface.
 RasterPaths rasterPaths(const Surface& surface, const RasterOptions& options);
 
 /// The feed angle a in [0, pi) whose plane normal e = (-sin a, cos a, 0) maximises
