@@ -153,6 +153,44 @@ std::string pathsToJson(const PathsReport& report, const ToolPath& path) {
   } else {
     document["orientation"] = nullptr;
   }
+  if (report.linking) {
+    const LinkStats& l = *report.linking;
+    Json linking;
+    linking["units"] = l.units;
+    linking["reversed_passes"] = l.reversedPasses;
+    linking["rotated_loops"] = l.rotatedLoops;
+    linking["direct_links"] = l.directLinks;
+    linking["local_retracts"] = l.localRetracts;
+    linking["unproven_links"] = l.unprovenLinks;
+    linking["strategy_links"] = l.strategyLinks;
+    linking["first_plunge_shortened"] = l.firstPlungeShortened;
+    linking["direct_link_length"] = l.directLinkLength;
+    linking["gouge_allowance"] = l.gougeAllowance;
+    linking["clearance"] = l.clearance;
+    linking["plunge"] = l.plunge;
+    linking["direct_link_max"] = l.directLinkMax;
+    document["linking"] = linking;
+  } else {
+    document["linking"] = nullptr;
+  }
+  if (report.motion) {
+    const GcodeMotion& m = *report.motion;
+    Json motion;
+    motion["feed_rate"] = report.feedRate;
+    motion["plunge_feed_rate"] = report.plungeFeedRate;
+    motion["rapid_rate"] = report.rapidRate;
+    motion["feed_length"] = m.feedLength;
+    motion["plunge_length"] = m.plungeLength;
+    motion["rapid_length"] = m.rapidLength;
+    motion["feed_minutes"] = m.feedMinutes;
+    motion["plunge_minutes"] = m.plungeMinutes;
+    motion["rapid_minutes"] = m.rapidMinutes;
+    motion["non_cutting_minutes"] = m.plungeMinutes + m.rapidMinutes;
+    motion["cycle_minutes"] = m.minutes;
+    document["motion"] = motion;
+  } else {
+    document["motion"] = nullptr;
+  }
   document["seconds"] = report.seconds;
   Json passes = Json::array();
   auto finite = [](const Vec3& p) {
@@ -167,6 +205,7 @@ std::string pathsToJson(const PathsReport& report, const ToolPath& path) {
   for (const ToolPass& pass : path.passes) {
     Json p;
     p["retract_before"] = pass.retractBefore;
+    if (pass.retract) p["retract"] = {{"height", pass.retract->height}, {"plunge", pass.retract->plunge}};
     p["start"] = vec(pass.start);
     Json moves = Json::array();
     for (const ToolMove& move : pass.moves) moves.push_back(moveJson(move));
