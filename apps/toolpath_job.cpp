@@ -160,6 +160,15 @@ JobResult runToolpathJob(const Surface& surface, const std::string& source,
     say(progress, "ordering and linking the passes");
     try {
       LinkedPath linked = linkToolPath(surface, result.path, options.linking);
+      if (result.report.gouge && !linked.origin.empty()) {
+        // The gouge check ran in the strategy's order: name its deepest pass in the new one.
+        GougeLocation& deepest = result.report.gouge->deepest;
+        const auto at = std::find(linked.origin.begin(), linked.origin.end(), deepest.pass);
+        const auto index = static_cast<std::size_t>(at - linked.origin.begin());
+        if (at != linked.origin.end() && linked.reversed[index] && !deepest.onLink)
+          deepest.move = linked.path.passes[index].moves.size() - 1 - deepest.move;
+        deepest.pass = index;
+      }
       result.path = std::move(linked.path);
       result.report.linking = linked.stats;
     } catch (const Error& error) {

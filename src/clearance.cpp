@@ -98,10 +98,10 @@ double HeightBound::above(Vec2 a, Vec2 b, double radius) const {
 // surface: sphere tracing on the distance's proven lower bound. dist(., surface) is
 // 1-Lipschitz, so a centre p with dist(p) >= need + m clears every centre within m of p;
 // each step advances by that margin. Gives up (false) when the margin falls below
-// `minStep` (the path comes too close, or creeps along the limit) or after kMaxSteps.
+// `minStep` (the path comes too close, or creeps along the limit) or after `maxSteps`
+// (raster's pass ends: kSegmentMaxSteps).
 bool segmentClears(const SurfaceDistance& distance, Vec3 a, Vec3 b, double need,
-                   double reach, double minStep) {
-  constexpr int kMaxSteps = 4000;
+                   double reach, double minStep, int maxSteps) {
   const double length = norm(b - a);
   // A coarse look first, at steps of `reach` / 16: most failing candidates cut in visibly
   // somewhere, and one cheap query (settled by a few boxes, cutoff `need`) shows it.
@@ -111,7 +111,7 @@ bool segmentClears(const SurfaceDistance& distance, Vec3 a, Vec3 b, double need,
   }
   double t = 0.0;
   double stride = minStep;  // the last margin
-  for (int step = 0; step < kMaxSteps; ++step) {
+  for (int step = 0; step < maxSteps; ++step) {
     const Vec3 p = length > 0.0 ? a + (b - a) * (t / length) : a;
     // The cutoff: a bound tighter than need + twice the last margin (or reach) is not worth
     // its cells; the margin can then double from one step to the next, no more.

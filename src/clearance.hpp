@@ -12,6 +12,9 @@
 
 namespace scallop::detail {
 
+/// Sphere-tracing steps segmentClears takes by default before it gives up.
+inline constexpr int kSegmentMaxSteps = 4000;
+
 // The highest z of the surface over the horizontal R-neighbourhood of a segment, bounded
 // from above by branch and bound: a sub-patch lies in the convex hull of its control
 // points, so under its box's top, and outside the neighbourhood if its box's footprint is.
@@ -36,8 +39,9 @@ class HeightBound {
 // surface: sphere tracing on the distance's proven lower bound. dist(., surface) is
 // 1-Lipschitz, so a centre p with dist(p) >= need + m clears every centre within m of p;
 // each step advances by that margin. Gives up (false) when the margin falls below
-// `minStep` (the path comes too close, or creeps along the limit) or after kMaxSteps.
+// `minStep` (the path comes too close, or creeps along the limit) or after `maxSteps`
+// (raster's pass ends: kSegmentMaxSteps).
 bool segmentClears(const SurfaceDistance& distance, Vec3 a, Vec3 b, double need,
-                   double reach, double minStep);
+                   double reach, double minStep, int maxSteps = kSegmentMaxSteps);
 
 }  // namespace scallop::detail

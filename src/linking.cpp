@@ -17,6 +17,8 @@ namespace scallop {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+// Sphere-tracing steps a direct link's proof may take (see below).
+constexpr int kDirectLinkMaxSteps = 256;
 
 double resolved(const char* name, double value, double fallback) {
   if (!(std::isfinite(value) && value >= 0.0))
@@ -236,9 +238,12 @@ LinkedPath linkToolPath(const Surface& surface, const ToolPath& path, const Link
     const Vec3 e = passEnd(passes[i - 1]);
     const double allowedE = allowance(e);
     const double length = norm(s - e);
+    // A direct feed slides along the surface where its ends touch it, and the margins of
+    // sphere tracing stay near epsilon there: give up after kDirectLinkMaxSteps steps (a
+    // local retract is cheap) rather than creep.
     if (length <= out.stats.directLinkMax &&
         detail::segmentClears(distance, e, s, radius - std::max(allowedE, allowedS), radius,
-                              minStep)) {
+                              minStep, kDirectLinkMaxSteps)) {
       pass.retractBefore = false;
       ++out.stats.directLinks;
       out.stats.directLinkLength += length;
@@ -249,6 +254,14 @@ LinkedPath linkToolPath(const Surface& surface, const ToolPath& path, const Link
     if (verticalClears(e, top, allowedE) && verticalClears(s, top, allowedS)) {
       pass.retract = LocalRetract{height, std::min(out.stats.plunge, height - s.z)};
       ++out.stats.localRetracts;
+    } else if (length <= out.stats.directLinkMax &&
+               detail::segmentClears(distance, e, s, radius - std::max(allowedE, allowedS),
+                                     radius, minStep)) {
+      // No way up (an overhang above an end): the direct feed again, now with the full
+      // budget of steps, before the unproven retract.
+      pass.retractBefore = false;
+      ++out.stats.directLinks;
+      out.stats.directLinkLength += length;
     } else {
       ++out.stats.unprovenLinks;
     }

@@ -1,10 +1,10 @@
 #pragma once
 // Linking: the moves between the passes of a finished tool path (either strategy), so that
 // the tool does not climb to the safe height and plunge at feed before every pass. Passes
-// are put in an order that makes short links common, and each link is the cheapest of
-// three kinds that is PROVEN not to gouge: a direct feed at cutting height, a local retract
-// over the stock near the link, or (when neither is proven) the safe-height retract the
-// strategies make today.
+// are put in an order that makes short links common, and each link is the cheapest kind
+// that is PROVEN not to gouge: a direct feed at cutting height, or a local retract over the
+// stock near the link; only when neither is proven, the safe-height retract the strategies
+// make.
 //
 // Contract
 // --------
@@ -43,10 +43,12 @@
 //            farther than R horizontally): the traverse and the vertical moves above Z + R
 //            are clear. The vertical moves below Z + R, E up and S down, are proven by sphere
 //            tracing to keep depth <= a(E) (resp. a(S)). d = min(plunge, h - S.z);
-//         3. the safe-height retract (retract absent), counted in unprovenLinks, when the
-//            vertical moves of 2 are not proven (the ball already cuts in at an end, or the
-//            surface overhangs it). The first pass gets {h, d} with h = S.z + d when its
-//            descent from above is proven the same way, else nothing.
+//         3. when the vertical moves of 2 are not proven (the surface overhangs an end), the
+//            direct feed of 1 again with a larger budget of steps (1 gives up after 256 steps,
+//            where the proof creeps along a move that slides on the surface; here 4,000);
+//         4. else the safe-height retract (retract absent), counted in unprovenLinks.
+//         The first pass gets {h, d} with h = S.z + d (the G-code then rapids down from the
+//         safe height to d above S) when its descent is proven as in 2, else nothing.
 //         Proof tool: sphere tracing (clearance.hpp's segmentClears, raster's pass-end
 //         proof) on gouge.hpp's proven lower bound of the distance, a 1-Lipschitz function:
 //         from a centre whose bound exceeds the limit by m, every centre within m is clear.
@@ -59,12 +61,12 @@
 //         control points does while clearance + the surface's height bound stay below it).
 // Complexity: ordering O(U (U + V)) for U units and V vertices of closed single passes
 //         (budget maxOrderingWork: scallop::Error beyond it, naming it). Each link: a
-//         height bound (at most kLinkMaxCells sub-patches) and at most three sphere traces
+//         height bound (at most kLinkMaxCells sub-patches) and at most four sphere traces
 //         of at most 4,256 distance queries each, every query capped at
 //         kLinkDistanceMaxCells cells: bounded per pass.
-// Errors: scallop::Error for options out of range (naming the option and value), a path
-//         whose units or radius differ from the surface's or are invalid, non-finite
-//         positions, or the ordering budget.
+// Errors: scallop::Error for options out of range (naming the option and value), an
+//         invalid surface, a path whose units differ from the surface's, a tool radius that
+//         is not positive, non-finite positions (naming the pass), or the ordering budget.
 
 #include <cstddef>
 #include <vector>
