@@ -288,8 +288,20 @@ std::string pathsSvg(const Surface& surface, const std::vector<std::vector<Vec3>
   for (const auto& line : iso) out += polyline(line, "iso");
   for (const auto& line : contactCurves) out += polyline(line, "contact");
   for (std::size_t i = 0; i < passes.size(); ++i) {
-    if (i > 0 && path.passes[i].retractBefore)
-      out += polyline({passes[i - 1].back(), passes[i].front()}, "rapid");
+    const ToolPass& pass = path.passes[i];
+    if (i > 0) {
+      const Vec3 from = passes[i - 1].back();
+      const Vec3 to = passes[i].front();
+      if (pass.retractBefore && pass.retract) {
+        // A local retract (linking.hpp): up, across at its height, down.
+        const double h = pass.retract->height;
+        out += polyline({from, {from.x, from.y, h}, {to.x, to.y, h}, to}, "rapid");
+      } else if (pass.retractBefore) {
+        out += polyline({from, to}, "rapid");
+      } else if (!(from == to)) {
+        out += polyline({from, to}, "centre");  // a direct feed
+      }
+    }
     out += polyline(passes[i], "centre");
   }
   out += "</svg>\n";

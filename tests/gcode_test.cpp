@@ -629,6 +629,33 @@ void expectInterpretedAs(const std::string& program, const ToolPath& path,
       EXPECT_LE(distance(gotMiddle, wantMiddle), 6.0 * tol) << where;
     }
   }
+
+  // The cycle time's lengths (gcodeMotion) against the interpreter's own motions: every
+  // traverse but the first two (from rs274's arbitrary start up to the safe height, and across
+  // to the first pass), the feeds at the plunge rate, and the other feeds (arcs as r x sweep
+  // with the change along the axis). Each printed point is within q / 2 per axis of the true
+  // one, so each length within 2 q of its true value; tiny arcs written as polygons and flat
+  // ones as chords differ from the arc by less than that.
+  double rapid = 0.0, plunge = 0.0, feed = 0.0;
+  std::size_t traverses = 0;
+  for (const Motion& m : canon.motions) {
+    if (m.kind == Motion::Kind::traverse) {
+      if (++traverses > 2) rapid += norm(m.end - m.start);
+      continue;
+    }
+    double length = norm(m.end - m.start);
+    if (m.kind == Motion::Kind::arc) {
+      const Vec3 s = m.start - m.centre;
+      const double radius = norm(s - dot(s, m.axis) * m.axis);
+      length = std::hypot(radius * m.sweep, dot(m.end - m.start, m.axis));
+    }
+    (std::fabs(m.feedRate - options.plungeFeedRate) < 1e-9 ? plunge : feed) += length;
+  }
+  const GcodeMotion motion = gcodeMotion(path, options, 100.0);
+  const double slack = 2.0 * quantum(path.units) * static_cast<double>(canon.motions.size()) + 1e-9;
+  EXPECT_NEAR(motion.rapidLength, rapid, slack);
+  EXPECT_NEAR(motion.plungeLength, plunge, slack);
+  EXPECT_NEAR(motion.feedLength, feed, slack);
 }
 
 // ---------------------------------------------------------------------------------------

@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <numbers>
 #include <numeric>
 #include <random>
 #include <string>
@@ -239,15 +240,16 @@ void expectLinkedWell(const Surface& surface, const ToolPath& input, const LinkO
   EXPECT_NO_THROW((void)gcodeProgram(linked.path, g));
 }
 
-TEST(Linking, PaperSurfacesContourSeveralRadii) {
-  for (const char* name : {"paper-1", "paper-2"}) {
-    const Surface surface = exampleSurface(name);
-    for (const double radius : {0.1, 0.25, 0.5}) {
-      const ToolPath path = optimalContourPath(surface, radius, 0.004);
-      expectLinkedWell(surface, path, {}, std::string(name) + " R " + std::to_string(radius));
-    }
+void expectContourOnNStarLinkedWell(const char* name) {
+  const Surface surface = exampleSurface(name);
+  for (const double radius : {0.1, 0.25, 0.5}) {
+    const ToolPath path = optimalContourPath(surface, radius, 0.004);
+    expectLinkedWell(surface, path, {}, std::string(name) + " R " + std::to_string(radius));
   }
 }
+
+TEST(Linking, Paper1ContourSeveralRadii) { expectContourOnNStarLinkedWell("paper-1"); }
+TEST(Linking, Paper2ContourSeveralRadii) { expectContourOnNStarLinkedWell("paper-2"); }
 
 TEST(Linking, PaperSurfacesHorizontalContoursWithLoops) {
   // Horizontal planes: paper-1's summit gives closed sections, started at any vertex.
@@ -277,14 +279,44 @@ TEST(Linking, PaperSurfacesRaster) {
   }
 }
 
-TEST(Linking, TeapotParts) {
-  for (const char* name : {"teapot-body", "teapot-lid", "teapot-spout", "teapot-handle"}) {
-    const Surface surface = exampleSurface(name);
-    for (const double radius : {0.1, 0.3}) {
-      const ToolPath path = contourPath(surface, {0, 0, 1}, 0.4, radius);
-      expectLinkedWell(surface, path, {}, std::string(name) + " R " + std::to_string(radius));
-    }
+// Two random graph patches side by side with a 1 in gap along x: raster planes across the
+// gap have two chains, the second entered from the safe height by the strategy, which the
+// linker relinks (direct feeds across the gap or local retracts over it).
+TEST(Linking, RasterAcrossAGap) {
+  std::mt19937_64 rng(7);
+  Surface s = randomGraphPatch(rng, 0.5);
+  Surface t = randomGraphPatch(rng, 0.5);
+  for (Vec3& p : t.patches[0].control) p.x += 4.0;
+  s.patches.push_back(t.patches[0]);
+  for (const double deg : {0.0, 10.0}) {
+    RasterOptions options;
+    options.angleRad = deg * std::numbers::pi / 180.0;
+    options.toolRadius = 0.25;
+    options.spacing = 0.25;
+    const ToolPath path = rasterPaths(s, options).path;
+    expectLinkedWell(s, path, {}, "gap at " + std::to_string(deg));
+    const LinkedPath linked = linkToolPath(s, path);
+    EXPECT_GT(linked.stats.directLinks + linked.stats.localRetracts, 0u)
+        << deg << " deg: " << linked.stats.unprovenLinks << " unproven, "
+        << linked.stats.strategyLinks << " strategy links";
   }
+}
+
+void expectTeapotPartLinkedWell(const char* name) {
+  const Surface surface = exampleSurface(name);
+  for (const double radius : {0.1, 0.3}) {
+    const ToolPath path = contourPath(surface, {0, 0, 1}, 0.4, radius);
+    expectLinkedWell(surface, path, {}, std::string(name) + " R " + std::to_string(radius));
+  }
+}
+
+TEST(Linking, TeapotBodyAndLid) {
+  expectTeapotPartLinkedWell("teapot-body");
+  expectTeapotPartLinkedWell("teapot-lid");
+}
+TEST(Linking, TeapotSpoutAndHandle) {
+  expectTeapotPartLinkedWell("teapot-spout");
+  expectTeapotPartLinkedWell("teapot-handle");
 }
 
 TEST(Linking, RandomSurfaces) {
