@@ -20,6 +20,7 @@
 #include "scallop/paths_output.hpp"
 #include "scallop/surface.hpp"
 #include "surface_options.hpp"
+#include "linking_options.hpp"
 #include "toolpath_job.hpp"
 
 namespace scallop::cli {
@@ -40,6 +41,9 @@ struct PathsOptions {
   std::string gcodePath;
   std::string svgPath;
   bool noGougeCheck = false;
+  std::string rapidRate;
+  bool noLinking = false;
+  bool oneWay = false;
 };
 
 void runPaths(const PathsOptions& options) {
@@ -60,21 +64,28 @@ void runPaths(const PathsOptions& options) {
   if (options.normal != "auto") job.normal = parseNormal(options.normal);
   if (!options.angle.empty()) job.angleDeg = parseFinite(options.angle, "angle", "degrees");
   job.gougeCheck = !options.noGougeCheck;
+  job.link = !options.noLinking;
+  job.linking.direction = options.oneWay ? PassDirection::keep : PassDirection::zigzag;
 
   const Surface surface = loadSurface(options.surface);
   const std::string source = sourceName(options.surface);
-  const JobResult result = runToolpathJob(surface, source, job, std::nullopt, {});
+  const double rapidRate = options.rapidRate.empty()
+                               ? defaultRapidRate(surface.units)
+                               : parsePositive(options.rapidRate, "rapid rate", "a positive rate");
+  JobResult result = runToolpathJob(surface, source, job, std::nullopt, {});
+  const GcodeDialect dialect = gcodeDialect(options.dialect);
+  const std::string title = fmt::format("scallop paths {} {}", options.strategy, source);
+  const GcodeOptions gcodeOptions = defaultGcodeOptions(surface, result.path, dialect, title);
+  result.report.motion = gcodeMotion(result.path, gcodeOptions, rapidRate);
+  result.report.feedRate = gcodeOptions.feedRate;
+  result.report.plungeFeedRate = gcodeOptions.plungeFeedRate;
+  result.report.rapidRate = rapidRate;
 
   std::vector<OutputFile> outputs;
   const bool anyOutput = !options.jsonPath.empty() || !options.gcodePath.empty() || !options.svgPath.empty();
   const std::string jsonPath = anyOutput ? options.jsonPath : std::string(kStandardStream);
   if (!jsonPath.empty()) outputs.push_back({jsonPath, pathsToJson(result.report, result.path)});
-  if (!options.gcodePath.empty()) {
-    const GcodeDialect dialect = gcodeDialect(options.dialect);
-    const std::string title = fmt::format("scallop paths {} {}", options.strategy, source);
-    outputs.push_back({options.gcodePath,
-                       gcodeProgram(result.path, defaultGcodeOptions(surface, result.path, dialect, title))});
-  }
+  if (!options.gcodePath.empty()) outputs.push_back({options.gcodePath, gcodeProgram(result.path, gcodeOptions)});
   if (!options.svgPath.empty()) {
     outputs.push_back({options.svgPath,
                        pathsSvg(surface, result.contactCurves, result.path,
@@ -86,9 +97,10 @@ void runPaths(const PathsOptions& options) {
     const PathStats& s = result.report.stats;
     fmt::print(stderr,
                "scallop: {}: {} paths, spacing {:.6g}, {} planes, {} components, tool-centre "
-               "length {:.6g} {}, {:.3f} s\n",
+               "length {:.6g} {}; {}; {:.3f} s\n",
                source, options.strategy, result.report.spacing, s.planes, s.components,
-               s.centreLength, unitsName(surface.units), result.report.seconds);
+               s.centreLength, unitsName(surface.units), cycleSummary(result.report, surface.units),
+               result.report.seconds);
   }
 }
 
@@ -122,6 +134,7 @@ void addPathsCommand(CLI::App& app) {
   paths->add_option("--angle", options->angle, "raster: feed direction in degrees from +x (default: the best)")
       ->type_name("DEG");
   addDialectOption(*paths, options->dialect);
+  addLinkingOptions(*paths, options->noLinking, options->oneWay, options->rapidRate);
   paths->add_option("--json", options->jsonPath, "write the report and the passes as JSON (- = standard output)")
       ->type_name("OUT");
   paths->add_option("--gcode", options->gcodePath, "write the G-code program")->type_name("OUT");

@@ -30,6 +30,7 @@
 #include "scallop/paths_output.hpp"
 #include "scallop/surface.hpp"
 #include "surface_options.hpp"
+#include "linking_options.hpp"
 #include "toolpath_job.hpp"
 
 namespace scallop::cli {
@@ -45,6 +46,9 @@ struct PlanOptions {
   std::string spacing;
   std::string dialect = "linuxcnc";
   std::string out = "scallop-out";
+  std::string rapidRate;
+  bool noLinking = false;
+  bool oneWay = false;
   bool quiet = false;
 };
 
@@ -73,6 +77,11 @@ void runPlan(const PlanOptions& options) {
                             ? (inch ? 0.001 : 0.025)
                             : parsePositive(options.scallopHeight, "scallop height", "a positive length");
   }
+  job.link = !options.noLinking;
+  job.linking.direction = options.oneWay ? PassDirection::keep : PassDirection::zigzag;
+  const double rapidRate = options.rapidRate.empty()
+                               ? defaultRapidRate(surface.units)
+                               : parsePositive(options.rapidRate, "rapid rate", "a positive rate");
   progress("computing the optimal slicing orientation N* (Gauss map, medial axis, certificate)");
   OptimalSlicing orientation = optimalSlicing(surface);
   JobResult result = runToolpathJob(surface, source, job, orientation, progress);
@@ -88,9 +97,14 @@ void runPlan(const PlanOptions& options) {
   const std::string figureTitle = fmt::format(
       "scallop plan: {} strategy on {}, R = {} {}, spacing {:.5g}, {} passes", options.strategy,
       source, job.toolRadius, unitsName(surface.units), report.spacing, result.path.passes.size());
+  const GcodeOptions gcodeOptions = defaultGcodeOptions(surface, result.path, dialect, title);
+  report.motion = gcodeMotion(result.path, gcodeOptions, rapidRate);
+  report.feedRate = gcodeOptions.feedRate;
+  report.plungeFeedRate = gcodeOptions.plungeFeedRate;
+  report.rapidRate = rapidRate;
   std::vector<OutputFile> outputs{
       {(dir / (dialect == GcodeDialect::grbl ? "toolpath.gcode" : "toolpath.ngc")).string(),
-       gcodeProgram(result.path, defaultGcodeOptions(surface, result.path, dialect, title))},
+       gcodeProgram(result.path, gcodeOptions)},
       {(dir / "report.json").string(), pathsToJson(report, result.path)},
       {(dir / "paths.svg").string(), pathsSvg(surface, result.contactCurves, result.path, figureTitle, false)},
       {(dir / "paths-plan.svg").string(), pathsSvg(surface, result.contactCurves, result.path, figureTitle, true)},
@@ -109,11 +123,13 @@ void runPlan(const PlanOptions& options) {
                         unitsName(surface.units), report.gouge->depthBound);
   fmt::print(stderr,
              "scallop plan: {} on {}: N* = ({:.4f}, {:.4f}, {:.4f}), alpha* = {:.3f} deg; spacing "
-             "{:.5g}, {} planes, {} components, tool-centre length {:.4f} {}{}; {:.2f} s -> {}/\n",
+             "{:.5g}, {} planes, {} components, tool-centre length {:.4f} {}{}; {}; {:.2f} s -> "
+             "{}/\n",
              options.strategy, source, orientation.normal.x, orientation.normal.y,
              orientation.normal.z, orientation.alphaRad * 180.0 / std::numbers::pi, report.spacing,
              s.planes, s.components, s.centreLength, unitsName(surface.units), gouge,
-             report.seconds + orientation.seconds, options.out);
+             cycleSummary(report, surface.units), report.seconds + orientation.seconds,
+             options.out);
 }
 
 }  // namespace
@@ -138,6 +154,7 @@ void addPlanCommand(CLI::App& app) {
   plan->add_option("--spacing", options->spacing, "plane spacing Delta instead of a scallop height")
       ->type_name("D");
   addDialectOption(*plan, options->dialect);
+  addLinkingOptions(*plan, options->noLinking, options->oneWay, options->rapidRate);
   plan->add_option("--out", options->out, "output folder (default scallop-out)")->type_name("DIR");
   plan->add_flag("--quiet", options->quiet, "no progress lines");
   plan->callback([options] { runPlan(*options); });

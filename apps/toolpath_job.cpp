@@ -91,7 +91,6 @@ void runContour(const Surface& surface, const JobOptions& options, JobResult& re
     for (const SectionCurve& curve : section.section.curves)
       result.contactCurves.push_back(curvePoints(curve));
   result.path = std::move(paths.path);
-  if (options.gougeCheck) checkGouge(surface, options, result, progress);
 }
 
 void runRaster(const Surface& surface, const JobOptions& options, JobResult& result,
@@ -121,7 +120,6 @@ void runRaster(const Surface& surface, const JobOptions& options, JobResult& res
       result.contactCurves.push_back(curvePoints(curve));
   result.report.envelope = paths.envelope;
   result.path = std::move(paths.path);
-  if (options.gougeCheck) checkGouge(surface, options, result, progress);
 }
 
 }  // namespace
@@ -163,6 +161,20 @@ JobResult runToolpathJob(const Surface& surface, const std::string& source,
   } catch (const Error& error) {
     throw Error(fmt::format("{}: {}", source, error.what()));
   }
+  // Linking (linking.hpp): the finished path's passes ordered, and needless retracts to the
+  // safe height replaced by proven direct feeds and local retracts.
+  if (options.link) {
+    say(progress, "ordering and linking the passes");
+    try {
+      LinkedPath linked = linkToolPath(surface, result.path, options.linking);
+      result.path = std::move(linked.path);
+      result.report.linking = linked.stats;
+    } catch (const Error& error) {
+      throw Error(fmt::format("{}: {}", source, error.what()));
+    }
+  }
+  // The gouge check on the path as it will be cut, links included.
+  if (options.gougeCheck) checkGouge(surface, options, result, progress);
   result.report.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
@@ -194,6 +206,8 @@ GcodeOptions defaultGcodeOptions(const Surface& surface, const ToolPath& path,
   options.safeHeight = top + (inch ? 0.2 : 5.0);
   return options;
 }
+
+double defaultRapidRate(Units units) { return units == Units::inch ? 200.0 : 5000.0; }
 
 Vec3 parseNormal(const std::string& text) {
   std::vector<std::string> parts;

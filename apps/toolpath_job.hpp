@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "scallop/gcode.hpp"
+#include "scallop/linking.hpp"
 #include "scallop/optimal_slicing.hpp"
 #include "scallop/paths_output.hpp"
 #include "scallop/surface.hpp"
@@ -24,6 +25,8 @@ struct JobOptions {
   std::optional<Vec3> normal;           ///< contour: N; none = the optimal N* (orient)
   std::optional<double> angleDeg;       ///< raster: feed angle; none = the best angle
   bool gougeCheck = true;               ///< measure the ball's interference (gouge.hpp)
+  bool link = true;                     ///< order and link the passes (linking.hpp)
+  LinkOptions linking;
 };
 
 struct JobResult {
@@ -46,6 +49,9 @@ JobResult runToolpathJob(const Surface& surface, const std::string& source,
 /// control points and of the path's tool tips.
 GcodeOptions defaultGcodeOptions(const Surface& surface, const ToolPath& path,
                                  GcodeDialect dialect, const std::string& title);
+
+/// The rapid rate assumed for the cycle time when none is given: 200 in/min or 5000 mm/min.
+double defaultRapidRate(Units units);
 
 /// Parses "X,Y,Z" (three finite numbers, not all zero) for --normal.
 Vec3 parseNormal(const std::string& text);

@@ -6,16 +6,21 @@
 //                             gouge check every R / 10 -> G-code
 //   BM_PlaneSection/<surface> one section by a plane z = c, c cycling through 64 levels over
 //                             the surface's height: sections per second
+//   BM_LinkContour/<surface>  linkToolPath on the contour plan's path (made once, outside
+//                             the loop): ordering and proven links, per pass
+//   BM_LinkRaster/<surface>   the same on the raster plan's path
 
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <string>
 #include <vector>
 
 #include "scallop/contour.hpp"
 #include "scallop/gcode.hpp"
 #include "scallop/gouge.hpp"
+#include "scallop/linking.hpp"
 #include "scallop/optimal_slicing.hpp"
 #include "scallop/raster.hpp"
 #include "scallop/section.hpp"
@@ -93,8 +98,54 @@ void BM_PlaneSection(benchmark::State& state) {
   state.SetLabel(surfaceName(state));
 }
 
+scallop::ToolPath contourPlanPath(const scallop::Surface& surface) {
+  const scallop::OptimalSlicing orientation = scallop::optimalSlicing(surface);
+  scallop::ContourOptions options;
+  options.normal = orientation.normal.z < 0.0 ? -orientation.normal : orientation.normal;
+  options.toolRadius = kToolRadius;
+  options.spacing = scallop::spacingForScallopHeight(kToolRadius, kScallopHeight,
+                                                     orientation.certifiedAlphaRad);
+  return scallop::contourPaths(surface, options).path;
+}
+
+scallop::ToolPath rasterPlanPath(const scallop::Surface& surface) {
+  scallop::RasterOptions options;
+  options.bestAngle = true;
+  options.toolRadius = kToolRadius;
+  options.scallopHeight = kScallopHeight;
+  return scallop::rasterPaths(surface, options).path;
+}
+
+void linkBenchmark(benchmark::State& state, const scallop::Surface& surface,
+                   const scallop::ToolPath& path) {
+  scallop::LinkStats stats;
+  for (auto _ : state) {
+    const scallop::LinkedPath linked = scallop::linkToolPath(surface, path);
+    benchmark::DoNotOptimize(linked.path.passes.data());
+    stats = linked.stats;
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(path.passes.size()));
+  state.counters["passes"] = static_cast<double>(path.passes.size());
+  state.counters["direct"] = static_cast<double>(stats.directLinks);
+  state.counters["local"] = static_cast<double>(stats.localRetracts);
+  state.counters["unproven"] = static_cast<double>(stats.unprovenLinks);
+  state.SetLabel(surfaceName(state));
+}
+
+void BM_LinkContour(benchmark::State& state) {
+  const scallop::Surface surface = scallop::exampleSurface(surfaceName(state));
+  linkBenchmark(state, surface, contourPlanPath(surface));
+}
+
+void BM_LinkRaster(benchmark::State& state) {
+  const scallop::Surface surface = scallop::exampleSurface(surfaceName(state));
+  linkBenchmark(state, surface, rasterPlanPath(surface));
+}
+
 }  // namespace
 
+BENCHMARK(BM_LinkContour)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LinkRaster)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_PlanContour)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_PlanRaster)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_PlaneSection)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond);

@@ -232,12 +232,38 @@ HighestTip validatePath(const ToolPath& path, const NumberFormat& format) {
   auto raise = [&highest](double z, std::string where) {
     if (z > highest.z) highest = {z, std::move(where)};
   };
+  Point previousEnd = {0.0, 0.0, 0.0};
   for (std::size_t p = 0; p < path.passes.size(); ++p) {
     const ToolPass& pass = path.passes[p];
     Point current = tipOf(pass.start, radius);
     const std::string passWhere = fmt::format("pass {}, start", p);
     checkPoint(current, "start", passWhere);
     raise(current[2], passWhere);
+    if (pass.retract) {
+      const LocalRetract& r = *pass.retract;
+      const std::string where = fmt::format("pass {}, retract", p);
+      if (p > 0 && !pass.retractBefore) {
+        throw Error(fmt::format("gcode: {}: a local retract on a pass without retractBefore",
+                                where));
+      }
+      if (!(std::isfinite(r.height) && std::fabs(r.height) < kGcodeMaxCoordinate &&
+            std::isfinite(r.plunge) && r.plunge >= 0.0 &&
+            r.plunge <= r.height - pass.start.z + format.quantum)) {
+        throw Error(fmt::format("gcode: {}: height h = {} and plunge d = {} must be finite with "
+                                "0 <= d <= h - start z + q (start z = {}, q = {})",
+                                where, r.height, r.plunge, pass.start.z, format.quantum));
+      }
+      if (p > 0) {
+        if (!(r.height - radius >= previousEnd[2])) {
+          throw Error(fmt::format("gcode: {}: height h = {} is below the previous pass's end "
+                                  "(centre z {}): a retract only rises",
+                                  where, r.height, previousEnd[2] + radius));
+        }
+        raise(r.height - radius, where + " height");
+      } else {
+        raise(current[2] + r.plunge, where + " plunge");
+      }
+    }
     for (std::size_t m = 0; m < pass.moves.size(); ++m) {
       const ToolMove& move = pass.moves[m];
       const std::string where = moveWhere(p, m);
@@ -280,6 +306,7 @@ HighestTip validatePath(const ToolPath& path, const NumberFormat& format) {
       }
       current = end;
     }
+    previousEnd = current;
   }
   return highest;
 }
@@ -391,9 +418,20 @@ class ProgramWriter {
     const Grid startGrid = {toGrid(start[0], format_), toGrid(start[1], format_),
                             toGrid(start[2], format_)};
     if (p == 0 || pass.retractBefore) {
-      const std::int64_t safe = toGrid(options_.safeHeight, format_);
-      motion("G0", {std::nullopt, std::nullopt, safe}, std::nullopt);
+      // Up (to the safe height, or to a local retract's height), across, rapid down to the
+      // plunge's start when the retract is local, and down the rest at the plunge feed.
+      const bool local = pass.retract.has_value();
+      const std::int64_t top = toGrid(
+          local && p > 0 ? pass.retract->height - radius : options_.safeHeight, format_);
+      motion("G0", {std::nullopt, std::nullopt, top}, std::nullopt);
       motion("G0", {startGrid[0], startGrid[1], std::nullopt}, std::nullopt);
+      if (local) {
+        // Down to d above the start; on later passes never above the traverse (d may exceed
+        // h - start z by a quantum of rounding).
+        double from = start[2] + pass.retract->plunge;
+        if (p > 0) from = std::min(from, pass.retract->height - radius);
+        motion("G0", {std::nullopt, std::nullopt, toGrid(from, format_)}, std::nullopt);
+      }
       motion("G1", {startGrid[0], startGrid[1], startGrid[2]}, options_.plungeFeedRate);
     } else {
       motion("G1", {startGrid[0], startGrid[1], startGrid[2]}, options_.feedRate);
@@ -535,6 +573,67 @@ std::string gcodeProgram(const ToolPath& path, const GcodeOptions& options) {
                             options.safeHeight, highest.z, highest.where));
   }
   return ProgramWriter(path, options, format).write();
+}
+
+GcodeMotion gcodeMotion(const ToolPath& path, const GcodeOptions& options, double rapidRate) {
+  const NumberFormat format = numberFormat(path.units);
+  validateOptions(options, format);
+  checkRate("rapidRate", rapidRate, format);
+  const HighestTip highest = validatePath(path, format);
+  if (!(options.safeHeight > highest.z)) {
+    throw Error(fmt::format("gcode: option safeHeight = {}: must be above the highest tool tip, "
+                            "z = {} ({})",
+                            options.safeHeight, highest.z, highest.where));
+  }
+  const double radius = path.toolRadius;
+  const double safe = options.safeHeight;
+  GcodeMotion out;
+  Point position = {0.0, 0.0, safe};
+  for (std::size_t p = 0; p < path.passes.size(); ++p) {
+    const ToolPass& pass = path.passes[p];
+    const Point start = tipOf(pass.start, radius);
+    if (p == 0 || pass.retractBefore) {
+      const bool local = pass.retract.has_value();
+      const double top = local && p > 0 ? pass.retract->height - radius : safe;
+      out.rapidLength += top - position[2];  // straight up (validated: never down)
+      // The first traverse starts from wherever the machine was: not counted.
+      if (p > 0) out.rapidLength += std::hypot(start[0] - position[0], start[1] - position[1]);
+      const double plungeFrom =
+          local ? std::min(start[2] + pass.retract->plunge, p > 0 ? top : safe) : top;
+      out.rapidLength += top - plungeFrom;
+      out.plungeLength += plungeFrom - start[2];
+    } else {
+      out.feedLength += std::hypot(std::hypot(start[0] - position[0], start[1] - position[1]),
+                                   start[2] - position[2]);
+    }
+    Point current = start;
+    for (const ToolMove& move : pass.moves) {
+      const Point end = tipOf(move.end, radius);
+      if (move.kind == MoveKind::arc) {
+        // r * sweep in the plane, and the change along its normal (a helix, within 10 q).
+        const Point centre = tipOf(move.center, radius);
+        const PlaneAxes axes = planeAxes(move.plane, "arc");
+        const auto f = static_cast<std::size_t>(axes.first);
+        const auto s = static_cast<std::size_t>(axes.second);
+        const auto n = static_cast<std::size_t>(axes.normal);
+        const double s1 = current[f] - centre[f], s2 = current[s] - centre[s];
+        const double sweep =
+            sweepAngle(s1, s2, end[f] - centre[f], end[s] - centre[s], move.clockwise);
+        out.feedLength += std::hypot(std::hypot(s1, s2) * sweep, end[n] - current[n]);
+      } else {
+        out.feedLength += std::hypot(std::hypot(end[0] - current[0], end[1] - current[1]),
+                                     end[2] - current[2]);
+      }
+      current = end;
+    }
+    position = current;
+  }
+  if (!path.passes.empty()) out.rapidLength += safe - position[2];  // the final retract
+  out.feedMinutes = out.feedLength / options.feedRate;
+  out.plungeMinutes = out.plungeLength / options.plungeFeedRate;
+  out.rapidMinutes = out.rapidLength / rapidRate;
+  out.minutes = out.feedMinutes + out.plungeMinutes + out.rapidMinutes;
+  return out;
 }
 
 std::vector<Vec3> arcPolyline(Vec3 start, Vec3 end, Vec3 center, Vec3 axis, double tolerance) {

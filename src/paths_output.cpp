@@ -182,6 +182,44 @@ std::string pathsToJson(const PathsReport& report, const ToolPath& path) {
   } else {
     document["orientation"] = nullptr;
   }
+  if (report.linking) {
+    const LinkStats& l = *report.linking;
+    Json linking;
+    linking["units"] = l.units;
+    linking["reversed_passes"] = l.reversedPasses;
+    linking["rotated_loops"] = l.rotatedLoops;
+    linking["direct_links"] = l.directLinks;
+    linking["local_retracts"] = l.localRetracts;
+    linking["unproven_links"] = l.unprovenLinks;
+    linking["strategy_links"] = l.strategyLinks;
+    linking["first_plunge_shortened"] = l.firstPlungeShortened;
+    linking["direct_link_length"] = l.directLinkLength;
+    linking["gouge_allowance"] = l.gougeAllowance;
+    linking["clearance"] = l.clearance;
+    linking["plunge"] = l.plunge;
+    linking["direct_link_max"] = l.directLinkMax;
+    document["linking"] = linking;
+  } else {
+    document["linking"] = nullptr;
+  }
+  if (report.motion) {
+    const GcodeMotion& m = *report.motion;
+    Json motion;
+    motion["feed_rate"] = report.feedRate;
+    motion["plunge_feed_rate"] = report.plungeFeedRate;
+    motion["rapid_rate"] = report.rapidRate;
+    motion["feed_length"] = m.feedLength;
+    motion["plunge_length"] = m.plungeLength;
+    motion["rapid_length"] = m.rapidLength;
+    motion["feed_minutes"] = m.feedMinutes;
+    motion["plunge_minutes"] = m.plungeMinutes;
+    motion["rapid_minutes"] = m.rapidMinutes;
+    motion["non_cutting_minutes"] = m.plungeMinutes + m.rapidMinutes;
+    motion["cycle_minutes"] = m.minutes;
+    document["motion"] = motion;
+  } else {
+    document["motion"] = nullptr;
+  }
   document["seconds"] = report.seconds;
   Json passes = Json::array();
   auto finite = [](const Vec3& p) {
@@ -196,6 +234,7 @@ std::string pathsToJson(const PathsReport& report, const ToolPath& path) {
   for (const ToolPass& pass : path.passes) {
     Json p;
     p["retract_before"] = pass.retractBefore;
+    if (pass.retract) p["retract"] = {{"height", pass.retract->height}, {"plunge", pass.retract->plunge}};
     p["start"] = vec(pass.start);
     Json moves = Json::array();
     for (const ToolMove& move : pass.moves) moves.push_back(moveJson(move));
@@ -278,8 +317,20 @@ std::string pathsSvg(const Surface& surface, const std::vector<std::vector<Vec3>
   for (const auto& line : iso) out += polyline(line, "iso");
   for (const auto& line : contactCurves) out += polyline(line, "contact");
   for (std::size_t i = 0; i < passes.size(); ++i) {
-    if (i > 0 && path.passes[i].retractBefore)
-      out += polyline({passes[i - 1].back(), passes[i].front()}, "rapid");
+    const ToolPass& pass = path.passes[i];
+    if (i > 0) {
+      const Vec3 from = passes[i - 1].back();
+      const Vec3 to = passes[i].front();
+      if (pass.retractBefore && pass.retract) {
+        // A local retract (linking.hpp): up, across at its height, down.
+        const double h = pass.retract->height;
+        out += polyline({from, {from.x, from.y, h}, {to.x, to.y, h}, to}, "rapid");
+      } else if (pass.retractBefore) {
+        out += polyline({from, to}, "rapid");
+      } else if (!(from == to)) {
+        out += polyline({from, to}, "centre");  // a direct feed
+      }
+    }
     out += polyline(passes[i], "centre");
   }
   out += "</svg>\n";

@@ -45,8 +45,10 @@
 #include <vector>
 
 #include "rs274.hpp"
+#include "scallop/contour.hpp"
 #include "scallop/error.hpp"
 #include "scallop/gcode.hpp"
+#include "scallop/linking.hpp"
 #include "scallop/toolpath.hpp"
 
 #ifndef SCALLOP_RS274_PATH
@@ -135,6 +137,7 @@ double safeHeightFor(const ToolPath& path, double margin) {
       }
       current = move.end;
     }
+    if (pass.retract) top = std::max(top, pass.retract->height);
   }
   return top - path.toolRadius + margin;
 }
@@ -156,6 +159,7 @@ ToolPath scaled(ToolPath path, double factor, Units units) {
   path.toolRadius *= factor;
   for (ToolPass& pass : path.passes) {
     pass.start = factor * pass.start;
+    if (pass.retract) pass.retract = LocalRetract{factor * pass.retract->height, factor * pass.retract->plunge};
     for (ToolMove& move : pass.moves) {
       move.end = factor * move.end;
       move.center = factor * move.center;
@@ -211,6 +215,29 @@ ToolPath arcsPath() {
       path.passes.push_back(pass);
       ++index;
     }
+  }
+  return path;
+}
+
+// The same path with local retracts (toolpath.hpp) on its retracted passes: a random
+// height above both ends of the link and a random plunge distance, some of them the whole
+// descent (d = h - start z) and some none (d = 0); the first pass gets a plunge only.
+ToolPath withLocalRetracts(ToolPath path, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (std::size_t p = 0; p < path.passes.size(); ++p) {
+    ToolPass& pass = path.passes[p];
+    if (!pass.retractBefore && p > 0) continue;
+    const double below = p == 0 ? pass.start.z
+                                : std::max(pass.start.z, (path.passes[p - 1].moves.empty()
+                                                              ? path.passes[p - 1].start
+                                                              : path.passes[p - 1].moves.back().end)
+                                                             .z);
+    const double height = below + 0.3 * unit(rng);
+    const double choice = unit(rng);
+    const double span = height - pass.start.z;
+    const double plunge = choice < 0.2 ? 0.0 : choice < 0.4 ? span : span * unit(rng);
+    pass.retract = LocalRetract{height, plunge};
   }
   return path;
 }
@@ -424,13 +451,20 @@ std::vector<Motion> expectedCuts(const ToolPath& path, const GcodeOptions& optio
     link.kind = Motion::Kind::feed;
     link.end = start;
     if (p == 0 || pass.retractBefore) {
-      link.start = {start.x, start.y, options.safeHeight};
+      // From the safe height, or from d above the start after a local retract.
+      link.start = {start.x, start.y,
+                    pass.retract ? start.z + pass.retract->plunge : options.safeHeight};
       link.feedRate = options.plungeFeedRate;
+      // A plunge that rounds to nothing (d < q / 2) is left out, as every zero-length move.
+      const double scale = path.units == Units::inch ? 1e5 : 1e4;  // 1 / q, as the writer's
+      if (std::llround(link.start.z * scale) == std::llround(start.z * scale)) {
+        link.kind = Motion::Kind::traverse;
+      }
     } else {
       link.start = previous;
       link.feedRate = options.feedRate;
     }
-    cuts.push_back(link);
+    if (link.kind == Motion::Kind::feed) cuts.push_back(link);
     Vec3 current = start;
     for (const ToolMove& move : pass.moves) {
       Motion m;
@@ -489,8 +523,10 @@ std::vector<CanonCall> interpret(const std::string& program) {
 }
 
 // Checks the program against LinuxCNC: accepted; units; spindle; the cutting motions one to
-// one with the ToolPath within the read-back tolerance; rapid moves only straight up to the
-// safe height or across at it; the program ending at the safe height.
+// one with the ToolPath within the read-back tolerance; rapid moves only straight up (to the
+// safe height or a local retract's height), across at one of those heights, or straight down
+// to where a plunge starts (d above a pass start after a local retract); the program ending
+// at the safe height.
 void expectInterpretedAs(const std::string& program, const ToolPath& path,
                          const GcodeOptions& options) {
   const std::vector<CanonCall> calls = interpret(program);
@@ -521,6 +557,20 @@ void expectInterpretedAs(const std::string& program, const ToolPath& path,
 
   const double tol = readBackTolerance(path.units);
   const double safe = options.safeHeight;
+  // Tip heights a rapid may rise to and cross at, and points a rapid may descend to.
+  std::vector<double> levels{safe};
+  std::vector<Vec3> plungeStarts;
+  for (std::size_t p = 0; p < path.passes.size(); ++p) {
+    const ToolPass& pass = path.passes[p];
+    if (!pass.retract || !(p == 0 || pass.retractBefore)) continue;
+    if (p > 0) levels.push_back(pass.retract->height - path.toolRadius);
+    const Vec3 tip = tipOf(pass.start, path.toolRadius);
+    plungeStarts.push_back({tip.x, tip.y, tip.z + pass.retract->plunge});
+  }
+  const auto isLevel = [&](double z) {
+    return std::any_of(levels.begin(), levels.end(),
+                       [&](double level) { return std::fabs(z - level) <= tol; });
+  };
   std::vector<Motion> cuts;
   bool firstTraverse = true;
   for (const Motion& m : canon.motions) {
@@ -532,11 +582,20 @@ void expectInterpretedAs(const std::string& program, const ToolPath& path,
     const bool fromKnownPosition = !firstTraverse;
     firstTraverse = false;
     const bool vertical = distance(Vec3{m.start.x, m.start.y, 0}, Vec3{m.end.x, m.end.y, 0}) <= tol;
-    const bool atSafeHeight = std::fabs(m.start.z - safe) <= tol;
-    EXPECT_NEAR(m.end.z, safe, tol) << m.text;
-    EXPECT_TRUE(vertical || atSafeHeight) << "rapid across below the safe height: " << m.text;
-    if (vertical && fromKnownPosition) {
-      EXPECT_GE(m.end.z, m.start.z - tol) << "rapid downwards: " << m.text;
+    if (!fromKnownPosition) {
+      EXPECT_NEAR(m.end.z, safe, tol) << m.text;
+      continue;
+    }
+    if (!vertical) {
+      EXPECT_TRUE(std::fabs(m.start.z - m.end.z) <= tol && isLevel(m.start.z))
+          << "rapid across, not at the safe height or a retract's: " << m.text;
+    } else if (m.end.z < m.start.z - tol) {
+      EXPECT_TRUE(std::any_of(plungeStarts.begin(), plungeStarts.end(),
+                              [&](Vec3 p) { return distance(p, m.end) <= tol; }))
+          << "rapid downwards, not to a plunge's start: " << m.text;
+    } else {
+      EXPECT_TRUE(isLevel(m.end.z)) << "rapid up, not to the safe height or a retract's: "
+                                    << m.text;
     }
   }
   ASSERT_FALSE(canon.motions.empty());
@@ -570,6 +629,33 @@ void expectInterpretedAs(const std::string& program, const ToolPath& path,
       EXPECT_LE(distance(gotMiddle, wantMiddle), 6.0 * tol) << where;
     }
   }
+
+  // The cycle time's lengths (gcodeMotion) against the interpreter's own motions: every
+  // traverse but the first two (from rs274's arbitrary start up to the safe height, and across
+  // to the first pass), the feeds at the plunge rate, and the other feeds (arcs as r x sweep
+  // with the change along the axis). Each printed point is within q / 2 per axis of the true
+  // one, so each length within 2 q of its true value; tiny arcs written as polygons and flat
+  // ones as chords differ from the arc by less than that.
+  double rapid = 0.0, plunge = 0.0, feed = 0.0;
+  std::size_t traverses = 0;
+  for (const Motion& m : canon.motions) {
+    if (m.kind == Motion::Kind::traverse) {
+      if (++traverses > 2) rapid += norm(m.end - m.start);
+      continue;
+    }
+    double length = norm(m.end - m.start);
+    if (m.kind == Motion::Kind::arc) {
+      const Vec3 s = m.start - m.centre;
+      const double radius = norm(s - dot(s, m.axis) * m.axis);
+      length = std::hypot(radius * m.sweep, dot(m.end - m.start, m.axis));
+    }
+    (std::fabs(m.feedRate - options.plungeFeedRate) < 1e-9 ? plunge : feed) += length;
+  }
+  const GcodeMotion motion = gcodeMotion(path, options, 100.0);
+  const double slack = 2.0 * quantum(path.units) * static_cast<double>(canon.motions.size()) + 1e-9;
+  EXPECT_NEAR(motion.rapidLength, rapid, slack);
+  EXPECT_NEAR(motion.plungeLength, plunge, slack);
+  EXPECT_NEAR(motion.feedLength, feed, slack);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -816,6 +902,123 @@ TEST(GcodeValidation, BadOptionsNameTheOptionAndValue) {
   expectError(path, GcodeOptions{}, {"safeHeight", "nan"});
 }
 
+TEST(GcodeValidation, LocalRetractsMustRiseAndStayBelowTheSafeHeight) {
+  // linesPath: passes at y = 0, 0.1, 0.2, each from z = 0.5 to 0.5 (centres), R = 0.125.
+  ToolPath path = linesPath();
+  path.passes[1].retract = LocalRetract{0.6, 0.05};
+  const GcodeOptions options = optionsFor(path, GcodeDialect::linuxcnc);
+  EXPECT_NO_THROW((void)gcodeProgram(path, options));
+  ToolPath low = path;
+  low.passes[1].retract = LocalRetract{0.49, 0.0};  // below the previous end (and the start)
+  expectError(low, options, {"pass 1, retract", "0.49"});
+  ToolPath deep = path;
+  deep.passes[1].retract = LocalRetract{0.6, 0.2};  // d > h - start z = 0.1
+  expectError(deep, options, {"pass 1, retract", "plunge d = 0.2"});
+  ToolPath negative = path;
+  negative.passes[1].retract = LocalRetract{0.6, -0.01};
+  expectError(negative, options, {"pass 1, retract", "-0.01"});
+  ToolPath unlinked = path;
+  unlinked.passes[1].retractBefore = false;
+  expectError(unlinked, options, {"pass 1, retract", "without retractBefore"});
+  ToolPath high = path;
+  high.passes[2].retract = LocalRetract{options.safeHeight + 0.125 + 0.01, 0.0};
+  expectError(high, options, {"safeHeight", "pass 2, retract height"});
+  ToolPath notFinite = path;
+  notFinite.passes[1].retract = LocalRetract{kNaN, 0.0};
+  expectError(notFinite, options, {"pass 1, retract", "nan"});
+}
+
+// The cycle time of a path whose every length is worked out by hand (inch, R = 0.25, tips
+// = centres - 0.25, safe height 2, feeds 40 and 10, rapid 200 units per minute):
+//   pass 0 (first): rapid from the safe height not counted across; plunge at feed from the
+//     safe height 2 to its start's tip z = 0: plunge 2; line (0,0,0) -> (3,4,0): feed 5;
+//   pass 1, local retract h = 0.75 (tip 0.5), d = 0.1, start tip (3,0,0): rapid up 0.5,
+//     across |(3,4) - (3,0)| = 4, down 0.5 - 0.1 = 0.4; plunge 0.1; a counter-clockwise
+//     half turn in xy about (3,1,0) of radius 1 to (3,2,0): feed pi;
+//   pass 2, fed straight (retractBefore false) from (3,2,0) to (0,2,0): feed 3; a line up
+//     to (0,2,0.5): feed 0.5;
+//   pass 3, safe-height retract: rapid up 2 - 0.5 = 1.5, across to (1,2): 1; plunge 2;
+//     a line to (1,3,0): feed 1;
+//   the end: rapid up 2.
+// feed 5 + pi + 3 + 0.5 + 1 = 9.5 + pi, plunge 2 + 0.1 + 2 = 4.1,
+// rapid 0.5 + 4 + 0.4 + 1.5 + 1 + 2 = 9.4.
+ToolPath handWorkedPath() {
+  ToolPath path;
+  path.units = Units::inch;
+  path.toolRadius = 0.25;
+  const double r = 0.25;
+  ToolPass p0;
+  p0.start = {0, 0, r};
+  p0.moves = {lineTo({3, 4, r})};
+  ToolPass p1;
+  p1.start = {3, 0, r};
+  p1.retract = LocalRetract{0.75, 0.1};
+  p1.moves = {arcFrom({3, 0, r}, {3, 1, r}, ArcPlane::xy, false, kPi)};
+  ToolPass p2;
+  p2.retractBefore = false;
+  p2.start = {0, 2, r};
+  p2.moves = {lineTo({0, 2, 0.5 + r})};
+  ToolPass p3;
+  p3.start = {1, 2, r};
+  p3.moves = {lineTo({1, 3, r})};
+  path.passes = {p0, p1, p2, p3};
+  return path;
+}
+
+GcodeOptions handWorkedOptions() {
+  GcodeOptions options;
+  options.safeHeight = 2.0;
+  options.feedRate = 40.0;
+  options.plungeFeedRate = 10.0;
+  options.spindleRpm = 0.0;
+  return options;
+}
+
+TEST(GcodeMotion, HandWorkedLengthsAndMinutes) {
+  const GcodeMotion m = gcodeMotion(handWorkedPath(), handWorkedOptions(), 200.0);
+  EXPECT_NEAR(m.feedLength, 9.5 + kPi, 1e-12);
+  EXPECT_NEAR(m.plungeLength, 4.1, 1e-12);
+  EXPECT_NEAR(m.rapidLength, 9.4, 1e-12);
+  EXPECT_NEAR(m.feedMinutes, (9.5 + kPi) / 40.0, 1e-12);
+  EXPECT_NEAR(m.plungeMinutes, 0.41, 1e-12);
+  EXPECT_NEAR(m.rapidMinutes, 0.047, 1e-12);
+  EXPECT_NEAR(m.minutes, (9.5 + kPi) / 40.0 + 0.41 + 0.047, 1e-12);
+}
+
+TEST(GcodeMotion, FirstPassLocalPlungeAndHelicalArc) {
+  // One pass with a plunge of d = 0.3 only: rapid down 2 - 0.3 (tip start z = 0), plunge 0.3;
+  // then a quarter turn in zx of radius 1 that also moves 0.5 along y (a helix within
+  // G18, allowed only within 10 quanta: here checked on gcodeMotion's arithmetic alone, so
+  // the mismatch check is not reached by using a y change of 5e-5 = 5 q):
+  // feed sqrt((pi / 2)^2 + (5e-5)^2); then the final rise from the arc's end to 2.
+  ToolPath path;
+  path.units = Units::inch;
+  path.toolRadius = 0.25;
+  ToolPass pass;
+  pass.start = {0, 0, 0.25};
+  pass.retract = LocalRetract{0.55, 0.3};
+  ToolMove arc = arcFrom({0, 0, 0.25}, {1, 0, 0.25}, ArcPlane::zx, true, 0.5 * kPi);
+  arc.end.y += 5e-5;
+  pass.moves = {arc};
+  path.passes = {pass};
+  const GcodeMotion m = gcodeMotion(path, handWorkedOptions(), 100.0);
+  // Which way the arc turns (up or down) decides the final rise: compute its end tip z.
+  const double endTip = arc.end.z - 0.25;
+  EXPECT_NEAR(m.rapidLength, 1.7 + (2.0 - endTip), 1e-12);
+  EXPECT_NEAR(m.plungeLength, 0.3, 1e-12);
+  EXPECT_NEAR(m.feedLength, std::hypot(0.5 * kPi, 5e-5), 1e-12);
+  EXPECT_NEAR(m.minutes, m.feedLength / 40.0 + 0.03 + m.rapidLength / 100.0, 1e-12);
+}
+
+TEST(GcodeMotion, ValidatesTheRapidRate) {
+  try {
+    (void)gcodeMotion(handWorkedPath(), handWorkedOptions(), 0.0);
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("rapidRate"), std::string::npos) << e.what();
+  }
+}
+
 TEST(GcodeValidation, SafeHeightMustClearTheTopOfVerticalArcs) {
   // A half turn in G18 (G19) from x (y) = 0 to 2 about x (y) = 1, z = 0: the ends are at
   // z = 0, the middle at z = +1 or -1 depending on the direction (tips: 0.1 lower). Which
@@ -1056,6 +1259,32 @@ TEST_P(GcodeLinuxcncVariants, PolygonisedObliqueArc) {
 }
 
 TEST_P(GcodeLinuxcncVariants, LargeRandomPath) { check(inUnits(randomPath(20240607, 60, 50))); }
+
+TEST_P(GcodeLinuxcncVariants, HandWorkedLinks) {
+  ToolPath path = handWorkedPath();
+  path.passes[0].retract = LocalRetract{0.25 + 0.3, 0.3};
+  check(inUnits(path));
+}
+
+// A contour path over paper-1 (horizontal planes: open and closed sections) as the linker
+// relinks it: reversed passes, loops started elsewhere, direct feeds and local retracts.
+TEST_P(GcodeLinuxcncVariants, LinkedContourPath) {
+  const Surface surface = exampleSurface("paper-1");
+  ContourOptions contour;
+  contour.normal = {0, 0, 1};
+  contour.spacing = 0.1;
+  contour.toolRadius = 0.25;
+  const LinkedPath linked = linkToolPath(surface, contourPaths(surface, contour).path);
+  EXPECT_GT(linked.stats.localRetracts, 0u);
+  EXPECT_GT(linked.stats.directLinks, 0u);
+  check(inUnits(linked.path));
+}
+
+TEST_P(GcodeLinuxcncVariants, LocalRetracts) {
+  check(inUnits(withLocalRetracts(linesPath(), 11)));
+  check(inUnits(withLocalRetracts(arcsPath(), 12)));
+  check(inUnits(withLocalRetracts(randomPath(20240608, 40, 20), 13)));
+}
 
 INSTANTIATE_TEST_SUITE_P(
     Gcode, GcodeLinuxcncVariants,

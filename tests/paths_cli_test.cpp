@@ -90,6 +90,49 @@ TEST_F(PathsCli, PlanWithNoArgumentsWritesTheWholeFolder) {
   expectPlainNumbers(gcode);
 }
 
+// The plan's report carries the G-code's motion (lengths, minutes at the stated rates) and
+// the linking; --no-linking gives the strategy's path with its safe-height retracts, whose
+// time off the cut the linked plan cuts by more than 80 % (the target).
+TEST_F(PathsCli, PlanReportsCycleTimeAndLinking) {
+  const RunResult linked = run("plan --quiet --out a");
+  ASSERT_EQ(linked.exitCode, 0) << linked.err;
+  EXPECT_NE(linked.err.find("cycle "), std::string::npos) << linked.err;
+  EXPECT_NE(linked.err.find("local retracts"), std::string::npos) << linked.err;
+  const RunResult unlinked = run("plan --quiet --no-linking --rapid-rate 100 --out b");
+  ASSERT_EQ(unlinked.exitCode, 0) << unlinked.err;
+  const auto a = nlohmann::json::parse(readFile(workDir_ / "a" / "report.json"));
+  const auto b = nlohmann::json::parse(readFile(workDir_ / "b" / "report.json"));
+  for (const auto* report : {&a, &b}) {
+    const auto& m = (*report)["motion"];
+    ASSERT_TRUE(m.is_object());
+    EXPECT_EQ(m["feed_rate"], 40.0);
+    EXPECT_EQ(m["plunge_feed_rate"], 15.0);
+    const double feed = m["feed_length"].get<double>() / 40.0;
+    const double plunge = m["plunge_length"].get<double>() / 15.0;
+    const double rapid = m["rapid_length"].get<double>() / m["rapid_rate"].get<double>();
+    EXPECT_NEAR(m["feed_minutes"].get<double>(), feed, 1e-12 * feed);
+    EXPECT_NEAR(m["plunge_minutes"].get<double>(), plunge, 1e-12 * plunge);
+    EXPECT_NEAR(m["rapid_minutes"].get<double>(), rapid, 1e-12 * rapid);
+    EXPECT_NEAR(m["cycle_minutes"].get<double>(), feed + plunge + rapid, 1e-12 * (feed + plunge + rapid));
+  }
+  EXPECT_EQ(a["motion"]["rapid_rate"], 200.0);
+  EXPECT_EQ(b["motion"]["rapid_rate"], 100.0);
+  ASSERT_TRUE(a["linking"].is_object());
+  EXPECT_TRUE(b["linking"].is_null());
+  const auto& l = a["linking"];
+  EXPECT_EQ(l["direct_links"].get<std::size_t>() + l["local_retracts"].get<std::size_t>() +
+                l["unproven_links"].get<std::size_t>() + l["strategy_links"].get<std::size_t>() + 1,
+            a["passes"].size());
+  // Air time at the same rapid rate: b's rapids were timed at 100, so rescale them to 200.
+  const double airA = a["motion"]["non_cutting_minutes"].get<double>();
+  const double airB = b["motion"]["plunge_minutes"].get<double>() +
+                      b["motion"]["rapid_length"].get<double>() / 200.0;
+  EXPECT_LE(airA, 0.2 * airB) << airA << " vs " << airB;
+  const RunResult bad = run("paths --example paper-1 --tool-radius 0.25 --spacing 0.1 --rapid-rate 0");
+  EXPECT_EQ(bad.exitCode, 1);
+  EXPECT_NE(bad.err.find("rapid rate"), std::string::npos) << bad.err;
+}
+
 TEST_F(PathsCli, PlanRasterReportsTheGougeCheck) {
   const RunResult result = run("plan --strategy raster --out r --quiet --dialect grbl");
   ASSERT_EQ(result.exitCode, 0) << result.err;
@@ -126,7 +169,8 @@ TEST_F(PathsCli, PlanGcodeIsAcceptedByLinuxCnc) {
     for (std::string line; std::getline(err, line);)
       EXPECT_TRUE(line.empty() || line == "executing") << "rs274 reported: " << line;
     // Count the feed moves (STRAIGHT_FEED and ARC_FEED) against the report's moves plus one
-    // plunge per retracted pass.
+    // plunge per retracted pass and one straight feed per pass fed from elsewhere than
+    // where the previous one ended (a direct link).
     std::size_t feeds = 0;
     std::stringstream canon(interpreted.out);
     for (std::string line; std::getline(canon, line);)
@@ -134,8 +178,13 @@ TEST_F(PathsCli, PlanGcodeIsAcceptedByLinuxCnc) {
         ++feeds;
     const auto report = nlohmann::json::parse(readFile(workDir_ / dir / "report.json"));
     std::size_t moves = 0;
-    for (const auto& pass : report["passes"])
-      moves += pass["moves"].size() + (pass["retract_before"].get<bool>() ? 1 : 0);
+    nlohmann::json previousEnd;
+    for (const auto& pass : report["passes"]) {
+      const bool linked = !pass["retract_before"].get<bool>() && pass["start"] != previousEnd;
+      moves += pass["moves"].size() + (pass["retract_before"].get<bool>() || linked ? 1 : 0);
+      previousEnd = pass["moves"].empty() ? pass["start"] : pass["moves"].back().begin().value();
+      if (previousEnd.is_object()) previousEnd = previousEnd["end"];
+    }
     // The writer may drop moves shorter than its printed precision; never adds any.
     EXPECT_LE(feeds, moves);
     EXPECT_GE(feeds, moves * 99 / 100);

@@ -31,9 +31,17 @@
 //         then G20|G21; G90 G94 G17 G40 G80 (absolute, feed per minute, xy plane, no cutter
 //         compensation, no canned cycle); G91.1 (I J K relative to the arc start); LinuxCNC
 //         only: G61 (exact path) or G64 P<blendTolerance>; S<rpm> M3 when spindleRpm > 0;
-//         G0 Z<safe>. Then per pass: with a retract (always for the first pass) G0 Z<safe>
-//         unless there already, G0 X Y of the start, G1 Z<start> at plungeFeedRate (straight
-//         down); without one, G1 straight to the start at feedRate. The feed is set by a line
+//         G0 Z<safe>. Then per pass: with a retract (always for the first pass) G0 Z<top>
+//         unless there already, top = the safe height, or h - R for a local retract {h, d}
+//         (toolpath.hpp; not on the first pass, which comes from the safe height), G0 X Y of
+//         the start, for a local retract G0 Z<start + d> (rapid down to d above the start;
+//         on later passes no higher than h - R),
+//         then G1 Z<start> at plungeFeedRate (straight down); without a retract, G1 straight
+//         to the start at feedRate. A local retract must rise (h - R >= the previous pass's
+//         last tip z), keep 0 <= d <= h - start z + q (q for rounding in transformed
+//         paths), and stay below the safe height (h - R
+//         counts as a tip below); else scallop::Error naming the pass. A local retract on
+//         a later pass without retractBefore is an error too. The feed is set by a line
 //         F<rate> of its own before a feed move whose rate differs from the last one set.
 //         Each move, at feedRate: G1 with the axes whose printed value changes;
 //         an arc: G17|G18|G19 on a line of its own when the plane changes, then G2 (the
@@ -113,6 +121,29 @@ struct GcodeOptions {
 /// The G-code program that cuts `path` (see the contract above). Throws scallop::Error on
 /// invalid options or an invalid path.
 std::string gcodeProgram(const ToolPath& path, const GcodeOptions& options);
+
+/// What the program gcodeProgram(path, options) writes costs in motion: the length of each
+/// kind of move (path units, of the true tips, before rounding) and the time at the rates.
+///   feed:   every pass's moves (arcs as arcs: r x sweep, with the change along the plane's
+///           normal as a helix) and the G1 links between passes, at options.feedRate;
+///   plunge: the G1 straight down into each retracted pass's start, at plungeFeedRate;
+///   rapid:  every G0: the rises (to the safe height or a local retract's height), the
+///           traverses between passes, the rapid descents of local retracts, and the final
+///           rise to the safe height; not the first traverse (from wherever the machine
+///           was) nor the program's first G0 Z<safe>, at rapidRate.
+/// Minutes = length / rate for each kind: no acceleration, and each G0 taken at rapidRate
+/// along its straight line (a machine moves G0 at its axes' limits: set rapidRate to what
+/// its slowest axis reaches). Validation as gcodeProgram's, and rapidRate as the feeds.
+struct GcodeMotion {
+  double feedLength = 0.0;
+  double plungeLength = 0.0;
+  double rapidLength = 0.0;
+  double feedMinutes = 0.0;
+  double plungeMinutes = 0.0;
+  double rapidMinutes = 0.0;
+  double minutes = 0.0;  ///< the estimated cycle time: the sum of the three
+};
+GcodeMotion gcodeMotion(const ToolPath& path, const GcodeOptions& options, double rapidRate);
 
 /// The polygon circumscribing an arc, for arcs in any plane: the arc runs counter-clockwise
 /// about the unit vector `axis` (right-hand rule) from `start` to `end` around `center`, of

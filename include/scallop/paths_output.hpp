@@ -19,7 +19,9 @@
 
 #include "scallop/contour.hpp"
 #include "scallop/envelope.hpp"
+#include "scallop/gcode.hpp"
 #include "scallop/gouge.hpp"
+#include "scallop/linking.hpp"
 #include "scallop/surface.hpp"
 #include "scallop/toolpath.hpp"
 #include "scallop/vector.hpp"
@@ -55,6 +57,13 @@ struct PathsReport {
   std::optional<GougeReport> gouge;  ///< the ball against the whole surface, sampled
   double gougeSampleSpacing = 0.0;   ///< the spacing the gouge check sampled at
   std::optional<OrientationSummary> orientation;
+  std::optional<LinkStats> linking;   ///< when the passes were linked (linking.hpp)
+  /// The G-code program's motion and estimated cycle time (gcode.hpp's gcodeMotion), with
+  /// the rates it assumed (units per minute).
+  std::optional<GcodeMotion> motion;
+  double feedRate = 0.0;
+  double plungeFeedRate = 0.0;
+  double rapidRate = 0.0;
   double seconds = 0.0;
 };
 

@@ -10,9 +10,19 @@
 // controller with the tool length measured to the tip drives.)
 // A ToolPath is a sequence of passes in machining order. A pass is one uninterrupted cutting
 // move: it starts at `start` and each move runs from where the previous one ended to its
-// `end`. Between passes the tool either retracts (rapid up to the safe height, across, and
-// down: ToolPass::retractBefore == true) or feeds straight from the previous pass's end to
-// this pass's start (false: the strategy has checked that this link cannot gouge).
+// `end`. Between passes the tool either retracts (ToolPass::retractBefore == true) or feeds
+// straight from the previous pass's end to this pass's start at the cutting feed (false:
+// the strategy or the linker, linking.hpp, has proven that this link cannot gouge).
+// A retract is one of two kinds:
+//   - to the safe height (ToolPass::retract absent; what the strategies make): rapid up to
+//     the G-code's safe height, across, and down at the plunge feed the whole way;
+//   - local (ToolPass::retract = {height h, plunge d}; made by the linker, which proves it
+//     clear): rapid straight up from the previous pass's end to centre height h, across at
+//     h, rapid straight down to start.z + d, and down the last d at the plunge feed.
+//     Invariants: h >= the previous pass's end z, 0 <= d <= h - start.z (the G-code
+//     writer allows one printed quantum more, for rounding in scaled paths). On
+//     the first pass (no previous end) the tool comes from the safe height and only d is
+//     used: rapid down to start.z + d, the rest at the plunge feed.
 // Arcs lie in a principal plane (the G-code planes G17 xy, G18 zx, G19 yz): `center` and
 // the two ends share the coordinate normal to the plane, and both ends lie at the same
 // distance from the centre (within rounding). `clockwise` is as seen from the positive end
@@ -20,6 +30,7 @@
 // or more is allowed, a full circle is not (start != end).
 
 #include <cstddef>
+#include <optional>
 #include <vector>
 
 #include "scallop/surface.hpp"
@@ -61,10 +72,18 @@ constexpr Vec3 toArcPlane(ArcPlane plane, Vec3 a) {
 // shift applied twice.
 constexpr Vec3 fromArcPlane(ArcPlane plane, Vec3 a) { return toArcPlane(plane, toArcPlane(plane, a)); }
 
+/// A retract that rises only as far as needed (see the contract above); ball centres.
+struct LocalRetract {
+  double height = 0.0;  ///< h: centre z of the traverse
+  double plunge = 0.0;  ///< d: the last part of the descent, made at the plunge feed
+};
+
 struct ToolPass {
   Vec3 start;                   ///< tool centre where the pass begins
   std::vector<ToolMove> moves;  ///< each from the previous end (or `start`) to its `end`
-  bool retractBefore = true;    ///< rapid via the safe height before this pass (see above)
+  bool retractBefore = true;    ///< retract before this pass, else feed straight (see above)
+  /// With retractBefore: a local retract; absent: via the safe height (see above).
+  std::optional<LocalRetract> retract = std::nullopt;
 };
 
 struct ToolPath {
