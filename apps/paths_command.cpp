@@ -43,6 +43,7 @@ struct PathsOptions {
   bool noGougeCheck = false;
   std::string rapidRate;
   bool noLinking = false;
+  bool noDropEnvelope = false;
   bool oneWay = false;
 };
 
@@ -65,6 +66,7 @@ void runPaths(const PathsOptions& options) {
   if (!options.angle.empty()) job.angleDeg = parseFinite(options.angle, "angle", "degrees");
   job.gougeCheck = !options.noGougeCheck;
   job.link = !options.noLinking;
+  job.dropEnvelope = !options.noDropEnvelope;
   job.linking.direction = options.oneWay ? PassDirection::keep : PassDirection::zigzag;
 
   const Surface surface = loadSurface(options.surface);
@@ -135,6 +137,10 @@ void addPathsCommand(CLI::App& app) {
       ->type_name("DEG");
   addDialectOption(*paths, options->dialect);
   addLinkingOptions(*paths, options->noLinking, options->oneWay, options->rapidRate);
+  paths->add_flag("--no-drop-envelope", options->noDropEnvelope,
+                 "keep the strategy's own centres (contour: r + R n; raster: the in-plane scallop hull) "
+                 "instead of lifting them to the proven gouge-free drop envelope; they cut into the "
+                 "surface where the report's gouge check says");
   paths->add_option("--json", options->jsonPath, "write the report and the passes as JSON (- = standard output)")
       ->type_name("OUT");
   paths->add_option("--gcode", options->gcodePath, "write the G-code program")->type_name("OUT");

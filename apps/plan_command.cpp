@@ -48,6 +48,7 @@ struct PlanOptions {
   std::string out = "scallop-out";
   std::string rapidRate;
   bool noLinking = false;
+  bool noDropEnvelope = false;
   bool oneWay = false;
   bool quiet = false;
 };
@@ -78,6 +79,7 @@ void runPlan(const PlanOptions& options) {
                             : parsePositive(options.scallopHeight, "scallop height", "a positive length");
   }
   job.link = !options.noLinking;
+  job.dropEnvelope = !options.noDropEnvelope;
   job.linking.direction = options.oneWay ? PassDirection::keep : PassDirection::zigzag;
   const double rapidRate = options.rapidRate.empty()
                                ? defaultRapidRate(surface.units)
@@ -155,6 +157,10 @@ void addPlanCommand(CLI::App& app) {
       ->type_name("D");
   addDialectOption(*plan, options->dialect);
   addLinkingOptions(*plan, options->noLinking, options->oneWay, options->rapidRate);
+  plan->add_flag("--no-drop-envelope", options->noDropEnvelope,
+                 "keep the strategy's own centres (contour: r + R n; raster: the in-plane scallop hull) "
+                 "instead of lifting them to the proven gouge-free drop envelope; they cut into the "
+                 "surface where the report's gouge check says");
   plan->add_option("--out", options->out, "output folder (default scallop-out)")->type_name("DIR");
   plan->add_flag("--quiet", options->quiet, "no progress lines");
   plan->callback([options] { runPlan(*options); });

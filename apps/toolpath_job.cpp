@@ -77,6 +77,7 @@ void runContour(const Surface& surface, const JobOptions& options, JobResult& re
   contour.normal = normal;
   contour.toolRadius = options.toolRadius;
   if (options.scallopHeight) contour.stretchThreshold = *options.scallopHeight;
+  contour.dropEnvelope = options.dropEnvelope;
   contour.spacing = options.spacing ? *options.spacing
                                     : spacingForScallopHeight(options.toolRadius,
                                                               *options.scallopHeight, alpha);
@@ -86,7 +87,7 @@ void runContour(const Surface& surface, const JobOptions& options, JobResult& re
   result.report.planeNormal = paths.normal;
   result.report.alphaRad = alpha;
   result.report.stats = paths.stats;
-  result.report.envelope = paths.envelope;
+  if (options.dropEnvelope) result.report.envelope = paths.envelope;
   for (const ContourSection& section : paths.sections)
     for (const SectionCurve& curve : section.section.curves)
       result.contactCurves.push_back(curvePoints(curve));
@@ -98,6 +99,7 @@ void runRaster(const Surface& surface, const JobOptions& options, JobResult& res
   RasterOptions raster;
   raster.toolRadius = options.toolRadius;
   if (options.scallopHeight) raster.stretchThreshold = *options.scallopHeight;
+  raster.dropEnvelope = options.dropEnvelope;
   if (options.angleDeg) {
     raster.angleRad = *options.angleDeg * kDeg;
   } else {
@@ -118,7 +120,7 @@ void runRaster(const Surface& surface, const JobOptions& options, JobResult& res
   for (const RasterSection& section : paths.sections)
     for (const SectionCurve& curve : section.section.curves)
       result.contactCurves.push_back(curvePoints(curve));
-  result.report.envelope = paths.envelope;
+  if (options.dropEnvelope) result.report.envelope = paths.envelope;
   result.path = std::move(paths.path);
 }
 

@@ -26,6 +26,7 @@ struct JobOptions {
   std::optional<double> angleDeg;       ///< raster: feed angle; none = the best angle
   bool gougeCheck = true;               ///< measure the ball's interference (gouge.hpp)
   bool link = true;                     ///< order and link the passes (linking.hpp)
+  bool dropEnvelope = true;             ///< lift to the drop envelope (envelope.hpp)
   LinkOptions linking;
 };
 

@@ -6,6 +6,11 @@
 //                             gouge check every R / 10 -> G-code
 //   BM_PlaneSection/<surface> one section by a plane z = c, c cycling through 64 levels over
 //                             the surface's height: sections per second
+//   BM_PlanRaster/<surface>/0 the same without the drop envelope (the hull's in-plane paths,
+//                             which gouge): what lifting costs, in the same run
+//   BM_DropEnvelope/<surface>/<strategy>  liftToDropEnvelope alone on the unlifted contour
+//                             (0) or raster (1) plan's path (made outside the loop); counters:
+//                             moves in and out, clearance proofs, proofs per second
 //   BM_LinkContour/<surface>  linkToolPath on the contour plan's path (made once, outside
 //                             the loop): ordering and proven links, per pass
 //   BM_LinkRaster/<surface>   the same on the raster plan's path
@@ -18,6 +23,7 @@
 #include <vector>
 
 #include "scallop/contour.hpp"
+#include "scallop/envelope.hpp"
 #include "scallop/gcode.hpp"
 #include "scallop/gouge.hpp"
 #include "scallop/linking.hpp"
@@ -69,6 +75,7 @@ void BM_PlanRaster(benchmark::State& state) {
   double depth = 0.0;
   for (auto _ : state) {
     scallop::RasterOptions options;
+    options.dropEnvelope = state.range(1) != 0;
     options.bestAngle = true;
     options.toolRadius = kToolRadius;
     options.scallopHeight = kScallopHeight;
@@ -82,6 +89,40 @@ void BM_PlanRaster(benchmark::State& state) {
   state.counters["passes"] = static_cast<double>(passes);
   state.counters["gouge_in"] = depth;
   state.SetLabel(surfaceName(state));
+}
+
+void BM_DropEnvelope(benchmark::State& state) {
+  const scallop::Surface surface = scallop::exampleSurface(surfaceName(state));
+  scallop::ToolPath path;
+  if (state.range(1) == 0) {
+    const scallop::OptimalSlicing orientation = scallop::optimalSlicing(surface);
+    scallop::ContourOptions options;
+    options.normal = orientation.normal.z < 0.0 ? -orientation.normal : orientation.normal;
+    options.toolRadius = kToolRadius;
+    options.spacing = scallop::spacingForScallopHeight(kToolRadius, kScallopHeight,
+                                                       orientation.certifiedAlphaRad);
+    options.dropEnvelope = false;
+    path = scallop::contourPaths(surface, options).path;
+  } else {
+    scallop::RasterOptions options;
+    options.bestAngle = true;
+    options.toolRadius = kToolRadius;
+    options.scallopHeight = kScallopHeight;
+    options.dropEnvelope = false;
+    path = scallop::rasterPaths(surface, options).path;
+  }
+  const scallop::SurfaceDistance distance(surface);
+  scallop::EnvelopeReport report;
+  for (auto _ : state) {
+    const scallop::ToolPath lifted = scallop::liftToDropEnvelope(distance, path, {}, report);
+    benchmark::DoNotOptimize(lifted.passes.data());
+  }
+  state.counters["moves_in"] = static_cast<double>(report.movesIn);
+  state.counters["moves_out"] = static_cast<double>(report.movesOut);
+  state.counters["proofs"] = static_cast<double>(report.proofs);
+  state.counters["proofs_per_s"] = benchmark::Counter(static_cast<double>(report.proofs),
+                                                      benchmark::Counter::kIsIterationInvariantRate);
+  state.SetLabel(std::string(surfaceName(state)) + (state.range(1) == 0 ? " contour" : " raster"));
 }
 
 void BM_PlaneSection(benchmark::State& state) {
@@ -147,5 +188,6 @@ void BM_LinkRaster(benchmark::State& state) {
 BENCHMARK(BM_LinkContour)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LinkRaster)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_PlanContour)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_PlanRaster)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PlanRaster)->Args({1, 1})->Args({2, 1})->Args({1, 0})->Args({2, 0})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_DropEnvelope)->Args({1, 0})->Args({2, 0})->Args({1, 1})->Args({2, 1})->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_PlaneSection)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond);
