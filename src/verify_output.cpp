@@ -124,7 +124,10 @@ std::string verifySvg(const SimulationReport& r, const VerifySources& sources) {
 
   // Each block's worst point.
   const double h = r.scallopHeight;
-  const double gougeSpan = std::max(r.maxGouge - r.gougeTolerance, std::numeric_limits<double>::min());
+  // Gouges on a logarithmic scale from the tolerance (or 1e-9 of the tool radius) to the
+  // deepest: thousandths and tenths both show.
+  const double floorGouge = std::max(r.gougeTolerance, 1e-9 * r.toolRadius);
+  const double gougeSpan = std::max(std::log(std::max(r.maxGouge, floorGouge) / floorGouge), 1e-300);
   std::vector<int> colour(bx * by, kNoSurfaceIndex);
   for (std::size_t b = 0; b < by; ++b) {
     for (std::size_t a = 0; a < bx; ++a) {
@@ -140,7 +143,7 @@ std::string verifySvg(const SimulationReport& r, const VerifySources& sources) {
       }
       int index = kNoSurfaceIndex;
       if (worstGouge >= 0.0) {
-        index = 10 + std::clamp(static_cast<int>((worstGouge - r.gougeTolerance) / gougeSpan * 5.0), 0, 4);
+        index = 10 + std::clamp(static_cast<int>(std::log(std::max(worstGouge, floorGouge) / floorGouge) / gougeSpan * 5.0), 0, 4);
       } else if (worstScallop >= 0.0) {
         index = std::clamp(static_cast<int>(worstScallop / (2.0 * h) * 10.0), 0, 9);
       }
@@ -154,7 +157,7 @@ std::string verifySvg(const SimulationReport& r, const VerifySources& sources) {
   const double height = static_cast<double>(design.rows) * design.spacing;
   const double scale = kMapSize / std::max(width, height);
   const double mapW = width * scale, mapH = height * scale;
-  const double pageW = kMargin + mapW + kBarX + 200.0, pageH = kTop + mapH + 60.0;
+  const double pageW = std::max(kMargin + mapW + kBarX + 200.0, 900.0), pageH = kTop + mapH + 60.0;
   const double cell = static_cast<double>(block) * design.spacing * scale;
   // Block (a, b) covers x from x0 - d/2 + a block d; rows drawn top down (y up).
   auto pageX = [&](double x) { return kMargin + (x - (design.x0 - 0.5 * design.spacing)) * scale; };
@@ -166,32 +169,40 @@ std::string verifySvg(const SimulationReport& r, const VerifySources& sources) {
       px(pageW), px(pageH));
   out += fmt::format("<title>{}</title>\n", escaped(title));
   out += "<style>\ntext { font-family: sans-serif; font-size: 13px; fill: #222222; }\n"
-         ".title { font-size: 15px; font-weight: bold; }\n.map rect { stroke: none; }\n</style>\n";
+         ".title { font-size: 15px; font-weight: bold; }\n</style>\n";
   out += fmt::format("<rect x=\"0\" y=\"0\" width=\"{}\" height=\"{}\" fill=\"#ffffff\"/>\n", px(pageW), px(pageH));
   out += fmt::format("<text class=\"title\" x=\"{}\" y=\"22\">{}</text>\n", px(kMargin), escaped(title));
   out += fmt::format(
-      "<text x=\"{}\" y=\"42\">R = {} {}, H = {} {}; deepest gouge {} {}, {} points beyond {} {} ({} {}&#178;)</text>\n",
+      "<text x=\"{}\" y=\"42\">R = {} {}, H = {} {}; deepest gouge {} {} (vertical), {} points beyond {} {} ({} {}&#178;)</text>\n",
       px(kMargin), lengthLabel(r.toolRadius), units, lengthLabel(h), units, lengthLabel(r.maxGouge), units,
       r.gougePoints, lengthLabel(r.gougeTolerance), units, lengthLabel(r.gougeArea), units);
   out += fmt::format(
-      "<text x=\"{}\" y=\"60\">scallop: max {} {}, 99th percentile {} {}, mean {} {}; above H on {} {}&#178;; grid {} x {} "
-      "at {} {}</text>\n",
+      "<text x=\"{}\" y=\"60\">scallop (along the normal): max {} {}, 99th percentile {} {}, mean {} {}; above H on {} "
+      "{}&#178;</text>\n",
       px(kMargin), lengthLabel(r.maxScallop), units, lengthLabel(r.scallopP99), units, lengthLabel(r.meanScallop), units,
-      lengthLabel(r.uncutArea), units, design.columns, design.rows, lengthLabel(design.spacing), units);
+      lengthLabel(r.uncutArea), units);
 
-  out += "<g class=\"map\">\n";
+  // One path per colour, in block units (a transform scales them to the page): each run of
+  // blocks of one colour in a row is "M a b h n v 1 h -n z", some 15 bytes.
+  std::array<std::string, 16> runs;
   for (std::size_t b = 0; b < by; ++b) {
+    const std::size_t top = by - 1 - b;  // y up
     std::size_t a = 0;
     while (a < bx) {
       const int index = colour[b * bx + a];
       std::size_t end = a + 1;
       while (end < bx && colour[b * bx + end] == index) ++end;
-      const double x = pageX(design.x0 - 0.5 * design.spacing) + static_cast<double>(a) * cell;
-      const double y = pageY(design.y0 - 0.5 * design.spacing) - static_cast<double>(b + 1) * cell;
-      out += fmt::format("<rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" fill=\"{}\"/>\n", px(x), px(y),
-                         px(static_cast<double>(end - a) * cell), px(cell), colourOf(index));
+      runs[static_cast<std::size_t>(index)] += fmt::format("M{} {}h{}v1h-{}z", a, top, end - a, end - a);
       a = end;
     }
+  }
+  out += fmt::format("<g transform=\"translate({},{}) scale({})\" shape-rendering=\"crispEdges\">\n",
+                     px(pageX(design.x0 - 0.5 * design.spacing)), px(pageY(design.y0 - 0.5 * design.spacing) -
+                                                                          static_cast<double>(by) * cell),
+                     fmt::format("{:.6f}", cell));
+  for (std::size_t index = 0; index < runs.size(); ++index) {
+    if (runs[index].empty()) continue;
+    out += fmt::format("<path fill=\"{}\" d=\"{}\"/>\n", colourOf(static_cast<int>(index)), runs[index]);
   }
   out += "</g>\n";
   out += fmt::format("<rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" fill=\"none\" stroke=\"#222222\"/>\n",
@@ -227,11 +238,15 @@ std::string verifySvg(const SimulationReport& r, const VerifySources& sources) {
     out += fmt::format("<text x=\"{}\" y=\"{}\">{}</text>\n", px(barX + 26.0), px(y + 4.0), label);
   }
   const double gougeTop = kTop + 20.0 + 10 * step + 40.0;
-  out += fmt::format("<text x=\"{}\" y=\"{}\">gouge ({})</text>\n", px(barX), px(gougeTop - 10.0), units);
+  out += fmt::format("<text x=\"{}\" y=\"{}\">gouge ({}, vertical)</text>\n", px(barX), px(gougeTop - 10.0), units);
   for (int i = 0; i < 5; ++i) {
     const double y = gougeTop + (4 - i) * step;
     out += fmt::format("<rect x=\"{}\" y=\"{}\" width=\"20\" height=\"{}\" fill=\"{}\"/>\n", px(barX), px(y), px(step),
                        kGougeColours[static_cast<std::size_t>(i)]);
+  }
+  for (int i = 1; i < 5; ++i) {  // the logarithmic steps' bounds
+    out += fmt::format("<text x=\"{}\" y=\"{}\">{}</text>\n", px(barX + 26.0), px(gougeTop + (5 - i) * step + 4.0),
+                       lengthLabel(floorGouge * std::exp(gougeSpan * i / 5.0)));
   }
   out += fmt::format("<text x=\"{}\" y=\"{}\">{}</text>\n", px(barX + 26.0), px(gougeTop + 5 * step + 4.0),
                      lengthLabel(r.gougeTolerance));
@@ -241,8 +256,12 @@ std::string verifySvg(const SimulationReport& r, const VerifySources& sources) {
   out += fmt::format("<rect x=\"{}\" y=\"{}\" width=\"20\" height=\"{}\" fill=\"{}\"/>\n", px(barX), px(noneY),
                      px(step), kNoSurface);
   out += fmt::format("<text x=\"{}\" y=\"{}\">no surface</text>\n", px(barX + 26.0), px(noneY + 16.0));
+  out += fmt::format("<text x=\"{}\" y=\"{}\">grid {} x {} points,</text>\n", px(barX), px(noneY + 52.0),
+                     design.columns, design.rows);
+  out += fmt::format("<text x=\"{}\" y=\"{}\">spacing {} {}</text>\n", px(barX), px(noneY + 70.0),
+                     lengthLabel(design.spacing), units);
   if (block > 1)
-    out += fmt::format("<text x=\"{}\" y=\"{}\">{} x {} points per square</text>\n", px(barX), px(noneY + 48.0),
+    out += fmt::format("<text x=\"{}\" y=\"{}\">{} x {} points per square</text>\n", px(barX), px(noneY + 88.0),
                        block, block);
   out += "</svg>\n";
   return out;

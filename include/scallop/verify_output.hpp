@@ -15,13 +15,14 @@
 //
 // SVG (verifySvg): the footprint seen from above (x right, y up), each grid point's verdict
 // as a colour: scallop height ((stock - design) |n_z|) on a 10-step scale from 0 to 2H (the last
-// step "2H or more"), gouges (design - stock > tolerance) on a 5-step red scale from the
-// tolerance to the deepest, points without surface light grey; the deepest gouge marked by a
+// step "2H or more"), gouges (design - stock > tolerance) on a 5-step red scale, logarithmic
+// from the tolerance to the deepest, points without surface light grey; the deepest gouge marked by a
 // ring; two colour bars with units, a title and a line of figures. Size: the grid is
 // drawn in blocks of b x b points (b = ceil(max(columns, rows) / 200), a block taking its
-// worst point: its deepest gouge if it has one, else its highest scallop), and each row's
-// runs of blocks of one colour merged into one rectangle: at most 200 x 200 rectangles,
-// typically a few thousand (some 100-400 kB). Deterministic.
+// worst point: its deepest gouge if it has one, else its highest scallop), each row's runs
+// of blocks of one colour merged into one rectangle, and the rectangles of one colour drawn
+// as one path in block units ("M a b h n v 1 h -n z", about 15 bytes a run): at most
+// 200 x 200 runs (600 kB); 100-300 kB on the paper's plans. Deterministic.
 
 #include <string>
 
