@@ -646,6 +646,51 @@ TEST(CutSimulation, ScallopOfAContourPlanOnAPlaneIsTheClosedForm) {
   EXPECT_GE(inner, cusp - report.heightErrorBound / cosAlpha);
 }
 
+TEST(CutSimulation, TranslatingSurfaceAndMovesTogetherChangesNothing) {
+  // Moved by a vector whose components are multiples of the grid spacing (powers of two, so
+  // every coordinate moves exactly), the grid moves with the surface's box and each point's
+  // stock and design move by dz: gouges and scallops stay the same up to rounding.
+  std::mt19937_64 rng(19);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  BezierPatch patch;
+  patch.degreeU = patch.degreeV = 3;
+  for (int j = 0; j <= 3; ++j)
+    for (int k = 0; k <= 3; ++k) patch.control.push_back({k + 0.1 * unit(rng), j + 0.1 * unit(rng), 0.3 * unit(rng)});
+  const Surface surface{Units::inch, {patch}};
+  std::vector<SweptMove> moves;
+  for (int k = 0; k < 200; ++k) {
+    SweptMove m = randomMove(rng, 0.25);
+    m.start.z -= 0.3;
+    m.end.z -= 0.3;
+    m.center.z -= 0.3;
+    moves.push_back(m);
+  }
+  SimulationOptions options;
+  options.toolRadius = 0.25;
+  options.scallopHeight = 0.001;
+  options.resolution = 1.0 / 64.0;
+  const SimulationReport before = simulateCut(surface, moves, options);
+  const Vec3 shift{2.0, -1.5, 0.75};
+  Surface moved = surface;
+  for (Vec3& c : moved.patches[0].control) c = c + shift;
+  std::vector<SweptMove> movedMoves = moves;
+  for (SweptMove& m : movedMoves) {
+    m.start = m.start + shift;
+    m.end = m.end + shift;
+    m.center = m.center + shift;
+  }
+  const SimulationReport after = simulateCut(moved, movedMoves, options);
+  ASSERT_EQ(before.design.columns, after.design.columns);
+  ASSERT_EQ(before.design.rows, after.design.rows);
+  EXPECT_GT(before.maxGouge, 0.01);  // the moves dip into the surface
+  EXPECT_NEAR(before.maxGouge, after.maxGouge, 1e-9);
+  EXPECT_NEAR(before.maxScallop, after.maxScallop, 1e-9);
+  EXPECT_NEAR(before.scallopP99, after.scallopP99, 1e-9);
+  EXPECT_EQ(before.surfacePoints, after.surfacePoints);
+  // Counts at thresholds may flip only for values within rounding of the threshold.
+  EXPECT_NEAR(static_cast<double>(before.gougePoints), static_cast<double>(after.gougePoints), 2.0);
+}
+
 TEST(CutSimulation, OptionsAndBudgetsAreCheckedWithClearErrors) {
   const Surface surface = plane(4.0, 0.0);
   SimulationOptions options;
