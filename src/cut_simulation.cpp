@@ -299,6 +299,7 @@ IndexRange indexRange(double lo, double hi, double origin, double spacing, std::
 // Jacobian det d(x, y) / d(u, v) is not of one strict sign on it (where the surface may fold
 // over a vertical tangent), to depth kDesignMaxDepth.
 constexpr std::size_t kCellPoints = 256;
+constexpr std::size_t kFoldCellPoints = 4;
 constexpr int kDesignMaxDepth = 10;
 
 struct DesignPatch {
@@ -326,7 +327,9 @@ void designCell(const DesignPatch& design, double u0, double u1, double v0, doub
   const std::size_t count = (is.hi - is.lo + 1) * (js.hi - js.lo + 1);
   const Bounds jacobian = bounds(restrictTo(design.jacobian, u0, u1, v0, v1));
   const bool oneSheet = jacobian.lo > 0.0 || jacobian.hi < 0.0;
-  if ((count > kCellPoints || !oneSheet) && depth < kDesignMaxDepth) {
+  // A fold cell over a few points is left to the multi-start Newton below: the work stays
+  // proportional to the grid points even where a vertical wall projects onto a grid line.
+  if ((count > kCellPoints || (!oneSheet && count > kFoldCellPoints)) && depth < kDesignMaxDepth) {
     const double um = 0.5 * (u0 + u1), vm = 0.5 * (v0 + v1);
     designCell(design, u0, um, v0, vm, depth + 1, grid, normalZ);
     designCell(design, um, u1, v0, vm, depth + 1, grid, normalZ);
@@ -477,6 +480,19 @@ void designHeights(const Surface& surface, HeightGrid& grid, std::vector<double>
   }
 }
 
+double sweepEvaluations(const std::vector<SweptMove>& moves, double toolRadius, const HeightGrid& stock) {
+  double total = 0.0;
+  for (std::size_t m = 0; m < moves.size(); ++m) {
+    requireMoveFinite(moves[m], m);
+    const MoveShape shape(moves[m], toolRadius);
+    const IndexRange is = indexRange(shape.lo().x - toolRadius, shape.hi().x + toolRadius, stock.x0, stock.spacing, stock.columns);
+    const IndexRange js = indexRange(shape.lo().y - toolRadius, shape.hi().y + toolRadius, stock.y0, stock.spacing, stock.rows);
+    if (is.empty() || js.empty()) continue;
+    total += static_cast<double>(is.hi - is.lo + 1) * static_cast<double>(js.hi - js.lo + 1);
+  }
+  return total;
+}
+
 std::size_t sweepMoves(const std::vector<SweptMove>& moves, double toolRadius, HeightGrid& stock,
                        std::vector<double>* lowered) {
   if (lowered) lowered->assign(moves.size(), 0.0);
@@ -527,6 +543,12 @@ SimulationReport simulateCut(const Surface& surface, const std::vector<SweptMove
 
   const auto sweepStart = std::chrono::steady_clock::now();
   report.stock = report.design;
+  const double evaluations = sweepEvaluations(moves, options.toolRadius, report.stock);
+  if (evaluations > options.maxEvaluations)
+    throw Error(fmt::format("the {} moves would take {:.3g} envelope evaluations on the grid of {} x {} points "
+                            "(spacing {}), more than the budget of {:.3g}: give a coarser resolution",
+                            moves.size(), evaluations, report.stock.columns, report.stock.rows, report.stock.spacing,
+                            options.maxEvaluations));
   std::fill(report.stock.z.begin(), report.stock.z.end(), report.stockTop);
   std::vector<double> lowered;
   report.sweptPointVisits = sweepMoves(moves, options.toolRadius, report.stock, &lowered);

@@ -498,6 +498,40 @@ TEST(DesignHeights, AnOverhangShowsItsHighestSheet) {
   expectDesignMatchesMesh(surface, 0.02, 2e-3, "overhang");
 }
 
+TEST(DesignHeights, AVerticalWallOnAGridLineEndsWithinItsBudget) {
+  // A wall x = 0 (its xy image a segment on the grid column through x = 0, the Jacobian zero
+  // everywhere) beside a floor z = 0.5: every cell over the wall is a fold cell; the
+  // quadtree stops at 4 points a cell (in a fraction of a second), and the floor is seen
+  // everywhere off the wall.
+  BezierPatch wall;
+  wall.degreeU = wall.degreeV = 1;
+  wall.control = {{0.0, 0.0, 0.0}, {0.0, 0.0, 1.0}, {0.0, 2.0, 0.0}, {0.0, 2.0, 1.0}};
+  const Surface surface{Units::inch, {wall, plane(2.0, 0.5).patches[0]}};
+  SimulationOptions options;
+  options.toolRadius = 0.25;
+  options.scallopHeight = 0.001;
+  options.resolution = 1.0 / 256.0;
+  HeightGrid grid = simulationGrid(surface, options);
+  designHeights(surface, grid);
+  std::size_t floor = 0;
+  for (std::size_t j = 0; j < grid.rows; ++j) {
+    for (std::size_t i = 0; i < grid.columns; ++i) {
+      const Vec2 p = grid.point(i, j);
+      if (p.x >= 0.0 && p.x <= 2.0 && p.y >= 0.0 && p.y <= 2.0) {
+        const double z = grid.z[j * grid.columns + i];
+        if (p.x == 0.0) {  // on the wall: the floor or a point of the wall (the contract)
+          ASSERT_GE(z, 0.5);
+          ASSERT_LE(z, 1.0);
+        } else {
+          ASSERT_EQ(z, 0.5) << p.x << ", " << p.y;
+        }
+        ++floor;
+      }
+    }
+  }
+  EXPECT_EQ(floor, 513u * 513u);
+}
+
 TEST(DesignHeights, ThePaperSurfacesAgainstADenseMesh) {
   for (const std::string name : {"paper-1", "paper-2"}) expectDesignMatchesMesh(exampleSurface(name), 0.02, 1e-4, name);
 }
@@ -718,6 +752,16 @@ TEST(CutSimulation, OptionsAndBudgetsAreCheckedWithClearErrors) {
   } catch (const Error& error) {
     EXPECT_NE(std::string(error.what()).find("line 17"), std::string::npos) << error.what();
   }
+  // The sweep's budget is counted before sweeping.
+  std::vector<SweptMove> many(2000, lineMove({-1.0, -1.0, 0.3}, {5.0, 5.0, 0.3}));
+  options.maxEvaluations = 1e8;
+  try {
+    simulateCut(surface, many, options);
+    FAIL() << "accepted a sweep over the budget";
+  } catch (const Error& error) {
+    EXPECT_NE(std::string(error.what()).find("more than the budget of 1e+08"), std::string::npos) << error.what();
+  }
+  options.maxEvaluations = 4e9;
   // An empty program: the stock stays at the surface's top; nothing is gouged.
   const SimulationReport report = simulateCut(surface, {}, options);
   EXPECT_EQ(report.maxGouge, 0.0);

@@ -48,14 +48,17 @@
 //         3-axis mill sees from above, or "no surface" (-infinity) off the footprint: each
 //         patch is cut into sub-patches (quadtree) until each covers at most 16 x 16 grid
 //         points and the Jacobian d(x, y) / d(u, v) has Bernstein coefficients of one
-//         strict sign on it (no fold: one sheet over each point), to depth 10 (1/1024 of
-//         the patch's side). At each grid point in a sub-patch's control box, Newton's
+//         strict sign on it (no fold: one sheet over each point) or it covers at most 4
+//         points, to depth 10 (1/1024 of the patch's side). At each grid point in a sub-patch's control box, Newton's
 //         method on (x, y)(u, v) = p is run from the sub-patch's centre (on a fold cell
 //         left at the depth limit, also from four more starts), projected onto the
 //         sub-patch, and a solution is accepted when it converges to |(x, y) - p| <= 1e-12
 //         scale (scale = surfaceScale); the highest one wins. Converged, not proven: on a
 //         fold cell (within 1/1024 of the patch's side of a vertical tangent) a sheet may be
-//         missed; elsewhere the value is exact up to rounding.
+//         missed, and over a vertical wall (the Jacobian zero everywhere, an image of no
+//         area) lying along a grid line the value is some point of the wall on the vertical
+//         line or the surface below, not necessarily the wall's top; elsewhere the value is
+//         exact up to rounding. Time O(P) Newton solves and sub-patches.
 // Output: SimulationReport: the two grids, and over the points with surface:
 //         gouge = design - stock > 0, measured vertically (max, where, points and area beyond
 //         gougeTolerance). A ball that comes within R - delta of the surface (an interference
@@ -73,7 +76,8 @@
 // Cost:   O(P log P + sum over moves of the grid points within R of the move's box) time,
 //         O(P) memory, P the grid points; the design O(P) Newton solves of a few steps.
 // Errors: scallop::Error for invalid options (naming the option and value), non-finite
-//         moves (naming the program's line), a grid over the budget.
+//         moves (naming the program's line), a grid over its budget (maxPoints), a sweep
+//         over its budget (maxEvaluations, counted before sweeping).
 
 #include <cstddef>
 #include <limits>
@@ -146,7 +150,10 @@ struct SimulationOptions {
   /// A gouge deeper than this counts (points, area, the CLI's --fail-on-gouge); >= 0.
   /// NaN: 1e-4 in or 0.0025 mm (ten quanta of the G-code's rounding, gcode.hpp).
   double gougeTolerance = std::numeric_limits<double>::quiet_NaN();
-  std::size_t maxPoints = 4'000'000;  ///< grid budget (two doubles per point)
+  std::size_t maxPoints = 4'000'000;  ///< grid budget (three doubles per point: 96 MB)
+  /// Sweep budget: the (move, grid point) pairs in the moves' boxes grown by R, summed
+  /// before the sweep (about a minute of work at the measured 50-60 million per second).
+  double maxEvaluations = 4e9;
 };
 
 struct SimulationReport {
@@ -186,6 +193,9 @@ HeightGrid simulationGrid(const Surface& surface, const SimulationOptions& optio
 /// The visible height of `surface` at every point of `grid` (see the contract); `normalZ`,
 /// if given, receives |n_z| of the unit normal there (0 off the surface).
 void designHeights(const Surface& surface, HeightGrid& grid, std::vector<double>* normalZ = nullptr);
+
+/// The (move, grid point) pairs in the moves' boxes grown by R: what the sweep may evaluate.
+double sweepEvaluations(const std::vector<SweptMove>& moves, double toolRadius, const HeightGrid& stock);
 
 /// Lowers `stock` by every move (the z-map sweep); returns (move, point) pairs evaluated.
 /// `lowered`, if given, receives per move the largest amount it lowered the stock by.
