@@ -3,12 +3,18 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <random>
+#include <regex>
+#include <sstream>
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
+
 #include "message_checks.hpp"
+#include "rs274.hpp"
 #include "scallop/error.hpp"
 #include "scallop/gcode.hpp"
 #include "scallop/gcode_reader.hpp"
@@ -111,6 +117,113 @@ TEST(GcodeReader, ReadsScallopsOwnProgramsBackToTheirTips) {
   }
   EXPECT_GT(arcs, 100u);
   EXPECT_GE(matched, ends.size() * 99 / 100);
+}
+
+// LinuxCNC's interpreter as the reference: a random program (lines, rapids, arcs in the three
+// planes both ways, full circles, helices, centres relative and absolute) is read by rs274,
+// whose canonical calls (STRAIGHT_TRAVERSE, STRAIGHT_FEED, ARC_FEED(first_end, second_end,
+// first_axis, second_axis, rotation, axis_end, ...), (first, second) = (x, y), (z, x),
+// (y, z) in XY, XZ, YZ, rotation > 0 counter-clockwise) must match the reader's moves one
+// for one, within the canonical printing (4 decimals).
+TEST(GcodeReader, AgreesWithLinuxCncOnRandomPrograms) {
+  const std::string rs274 = test::findRs274();
+  ASSERT_FALSE(rs274.empty()) << "rs274 (Debian package linuxcnc-uspace) is needed";
+  std::mt19937_64 rng(23);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int trial = 0; trial < 8; ++trial) {
+    std::string text = "G20 G90 G94 G40 G80 G91.1\nF30\nG0 X1 Y1 Z1\n";
+    std::array<double, 3> at = {1.0, 1.0, 1.0};
+    bool absoluteCentre = false;
+    auto fixed = [](double v) { return fmt::format("{:.4f}", v); };
+    for (int k = 0; k < 60; ++k) {
+      const int kind = static_cast<int>(rng() % 6);
+      if (kind <= 1) {
+        for (double& c : at) c = std::round((c + unit(rng) - 0.5) * 1e4) / 1e4;
+        text += fmt::format("{} X{} Y{} Z{}\n", kind == 0 ? "G0" : "G1", fixed(at[0]), fixed(at[1]), fixed(at[2]));
+        continue;
+      }
+      if (rng() % 4 == 0) {
+        absoluteCentre = !absoluteCentre;
+        text += absoluteCentre ? "G90.1\n" : "G91.1\n";
+      }
+      const int plane = static_cast<int>(rng() % 3);  // 0 G17, 1 G18, 2 G19
+      const std::array<int, 3> axes = plane == 0 ? std::array<int, 3>{0, 1, 2}
+                                      : plane == 1 ? std::array<int, 3>{2, 0, 1}
+                                                   : std::array<int, 3>{1, 2, 0};
+      const double radius = 0.2 + unit(rng);
+      const double a0 = 2.0 * 3.141592653589793 * unit(rng);
+      std::array<double, 3> centre = at;
+      centre[axes[0]] = std::round((at[axes[0]] - radius * std::cos(a0)) * 1e4) / 1e4;
+      centre[axes[1]] = std::round((at[axes[1]] - radius * std::sin(a0)) * 1e4) / 1e4;
+      const double r = std::hypot(at[axes[0]] - centre[axes[0]], at[axes[1]] - centre[axes[1]]);
+      const double a1 = kind == 5 ? std::atan2(at[axes[1]] - centre[axes[1]], at[axes[0]] - centre[axes[0]])
+                                  : 2.0 * 3.141592653589793 * unit(rng);
+      std::array<double, 3> end = at;
+      if (kind != 5) {  // 5: a full circle, the end at the start
+        end[axes[0]] = std::round((centre[axes[0]] + r * std::cos(a1)) * 1e4) / 1e4;
+        end[axes[1]] = std::round((centre[axes[1]] + r * std::sin(a1)) * 1e4) / 1e4;
+      }
+      if (kind == 4) end[axes[2]] = std::round((at[axes[2]] + unit(rng) - 0.5) * 1e4) / 1e4;  // helix
+      const char* letters = "IJK";
+      const char* names = "XYZ";
+      std::string block = fmt::format("G{} G{}", 17 + plane, rng() % 2 == 0 ? 2 : 3);
+      for (int a = 0; a < 3; ++a) block += fmt::format(" {}{}", names[a], fixed(end[a]));
+      for (const int a : {axes[0], axes[1]})
+        block += fmt::format(" {}{}", letters[a], fixed(absoluteCentre ? centre[a] : centre[a] - at[a]));
+      text += block + "\n";
+      at = end;
+    }
+    text += "M2\n";
+    const GcodeProgram program = parseGcodeProgram(text, "random.ngc");
+    const test::Rs274Run run = test::runRs274(rs274, text);
+    ASSERT_EQ(run.exitCode, 0) << run.err << "\n" << text;
+    static const std::regex call(R"(^\s*\d+ N\.\.\.\.\. ([A-Z_]+)\((.*)\)\s*$)");
+    std::vector<std::pair<std::string, std::vector<double>>> calls;
+    std::string plane = "CANON_PLANE_XY";
+    std::stringstream lines(run.out);
+    std::string line;
+    while (std::getline(lines, line)) {
+      std::smatch match;
+      if (!std::regex_match(line, match, call)) continue;
+      const std::string name = match[1];
+      if (name == "SELECT_PLANE") plane = match[2];
+      if (name != "STRAIGHT_TRAVERSE" && name != "STRAIGHT_FEED" && name != "ARC_FEED") continue;
+      std::vector<double> args;
+      std::stringstream list(match[2].str());
+      std::string arg;
+      while (std::getline(list, arg, ',')) args.push_back(std::stod(arg));
+      calls.push_back({name == "ARC_FEED" ? plane : name, args});
+    }
+    // rs274 starts at the origin: its first traverse is the reader's unknown start.
+    ASSERT_EQ(program.unknownStartMoves, 1u);
+    ASSERT_EQ(calls.size(), program.moves.size() + 1);
+    const double tolerance = 6e-5;
+    for (std::size_t k = 0; k < program.moves.size(); ++k) {
+      const ProgramMove& m = program.moves[k];
+      const auto& [name, args] = calls[k + 1];
+      SCOPED_TRACE(testing::Message() << "trial " << trial << " line " << m.line << ": " << name);
+      if (m.kind != ProgramMoveKind::arc) {
+        EXPECT_EQ(name, m.kind == ProgramMoveKind::rapid ? "STRAIGHT_TRAVERSE" : "STRAIGHT_FEED");
+        EXPECT_NEAR(args[0], m.end.x, tolerance);
+        EXPECT_NEAR(args[1], m.end.y, tolerance);
+        EXPECT_NEAR(args[2], m.end.z, tolerance);
+        continue;
+      }
+      const std::array<double, 3> end = {m.end.x, m.end.y, m.end.z};
+      const std::array<double, 3> centre = {m.center.x, m.center.y, m.center.z};
+      const std::array<int, 3> axes = m.plane == ArcPlane::xy ? std::array<int, 3>{0, 1, 2}
+                                      : m.plane == ArcPlane::zx ? std::array<int, 3>{2, 0, 1}
+                                                                : std::array<int, 3>{1, 2, 0};
+      EXPECT_EQ(name, m.plane == ArcPlane::xy ? "CANON_PLANE_XY" : m.plane == ArcPlane::zx ? "CANON_PLANE_XZ" : "CANON_PLANE_YZ");
+      EXPECT_NEAR(args[0], end[axes[0]], tolerance);
+      EXPECT_NEAR(args[1], end[axes[1]], tolerance);
+      EXPECT_NEAR(args[2], centre[axes[0]], tolerance);
+      EXPECT_NEAR(args[3], centre[axes[1]], tolerance);
+      EXPECT_EQ(args[4] > 0.0, !m.clockwise);
+      EXPECT_EQ(std::abs(args[4]), 1.0);
+      EXPECT_NEAR(args[5], end[axes[2]], tolerance);
+    }
+  }
 }
 
 TEST(GcodeReader, MalformedProgramsNameTheFileLineAndWord) {
