@@ -49,9 +49,9 @@
 //         patch is cut into sub-patches (quadtree) until each covers at most 16 x 16 grid
 //         points and the Jacobian d(x, y) / d(u, v) has Bernstein coefficients of one
 //         strict sign on it (no fold: one sheet over each point) or it covers at most 4
-//         points, to depth 10 (1/1024 of the patch's side). At each grid point in a sub-patch's control box, Newton's
-//         method on (x, y)(u, v) = p is run from the sub-patch's centre (on a fold cell
-//         left at the depth limit, also from four more starts), projected onto the
+//         points, to depth 10 (1/1024 of the patch's side). At each grid point in a
+//         sub-patch's control box, Newton's method on (x, y)(u, v) = p is run from the
+//         sub-patch's centre (on a fold cell, also from four more starts), projected onto the
 //         sub-patch, and a solution is accepted when it converges to |(x, y) - p| <= 1e-12
 //         scale (scale = surfaceScale); the highest one wins. Converged, not proven: on a
 //         fold cell (within 1/1024 of the patch's side of a vertical tangent) a sheet may be
@@ -63,17 +63,19 @@
 //         gouge = design - stock > 0, measured vertically (max, where, points and area beyond
 //         gougeTolerance). A ball that comes within R - delta of the surface (an interference
 //         delta, as gouge.hpp measures it) leaves a vertical gouge >= delta above the surface
-//         point nearest its centre q: the ball's bottom there is at c_z - sqrt(R^2 - rho^2)
-//         and q_z >= c_z - sqrt((R - delta)^2 - rho^2) (rho = |q_xy - c_xy|), and
-//         sqrt(R^2 - rho^2) - sqrt((R - delta)^2 - rho^2) >= delta; so the vertical gouge is
-//         never smaller than the interference (larger on slopes and at the surface's edges),
+//         point q nearest its centre c: with rho = |q_xy - c_xy| <= R - delta, the ball's
+//         bottom above q_xy is at c_z - sqrt(R^2 - rho^2), the stock no higher, the design
+//         no lower than q_z >= c_z - sqrt((R - delta)^2 - rho^2), and
+//         sqrt(R^2 - rho^2) - sqrt((R - delta)^2 - rho^2) >= delta (q above c: more still);
+//         so the vertical gouge is never smaller than the interference (larger on slopes and
+//         at the surface's edges), up to the grid's sampling of it;
 //         scallop = max(0, stock - design) |n_z| (n the surface's unit normal there: the
 //         distance from the stock's point to the surface's tangent plane, the scallop height
 //         along the normal as H is meant; exact on planes, within O(h^2 curvature) on
 //         curved surfaces) (max, where, 99th percentile, mean, points and area above H:
 //         "uncut"), counts of moves, rapids that cut (> gougeTolerance below
 //         what was there) and the first such line. Deterministic.
-// Cost:   O(P log P + sum over moves of the grid points within R of the move's box) time,
+// Cost:   O(P + sum over moves of the grid points within R of the move's box) time,
 //         O(P) memory, P the grid points; the design O(P) Newton solves of a few steps.
 // Errors: scallop::Error for invalid options (naming the option and value), non-finite
 //         moves (naming the program's line), a grid over its budget (maxPoints), a sweep
