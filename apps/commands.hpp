@@ -21,4 +21,8 @@ void addPathsCommand(CLI::App& app);
 /// `scallop plan`: the main job, surface to G-code, report and figures in one folder.
 void addPlanCommand(CLI::App& app);
 
+/// `scallop verify`: simulate a G-code program's cut and compare it with the surface.
+/// `exitStatus` receives the command's status (2: --fail-on-gouge and a gouge was found).
+void addVerifyCommand(CLI::App& app, int& exitStatus);
+
 }  // namespace scallop::cli

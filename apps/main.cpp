@@ -29,7 +29,8 @@ int main(int argc, char** argv) {
   CLI::App app{
       "Exact tool paths for ball-end milling: the scallop hull of a monotone chain "
       "(a section of a surface) and its offset, the tool-centre path; and the optimal slicing "
-      "orientation of a free-form surface; contour and raster tool paths and G-code from them.",
+      "orientation of a free-form surface; contour and raster tool paths and G-code from them;"
+      " and the simulation of a program's cut, to verify it.",
       "scallop"};
   app.set_version_flag("--version", std::string("scallop ") + SCALLOP_VERSION);
   app.require_subcommand(1);
@@ -37,6 +38,8 @@ int main(int argc, char** argv) {
   scallop::cli::addOrientCommand(app);
   scallop::cli::addPathsCommand(app);
   scallop::cli::addPlanCommand(app);
+  int status = 0;  // a command's own non-zero status that is not an error (verify --fail-on-gouge)
+  scallop::cli::addVerifyCommand(app, status);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
@@ -45,5 +48,5 @@ int main(int argc, char** argv) {
     // scallop::Error (bad input, unwritable output) and anything else, e.g. std::bad_alloc.
     return reportError(error.what());
   }
-  return 0;
+  return status;
 }

@@ -1,0 +1,800 @@
+// Tests of cut_simulation.hpp against references written here: the swept ball's lowest point
+// by dense sampling of ball positions along each move (refined by golden sections), closed
+// forms on planes (the cusp of two parallel passes, a plunge), the visible surface by a
+// dense triangle mesh, and the paper's plans against gouge.hpp's independent check.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <numbers>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "scallop/contour.hpp"
+#include "scallop/cut_simulation.hpp"
+#include "scallop/error.hpp"
+#include "scallop/gcode.hpp"
+#include "scallop/gcode_reader.hpp"
+#include "scallop/gouge.hpp"
+#include "scallop/optimal_slicing.hpp"
+#include "scallop/raster.hpp"
+#include "scallop/surface.hpp"
+#include "scallop/verify_output.hpp"
+
+namespace scallop {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kPi = std::numbers::pi;
+
+// ---------------------------------------------------------------------------------------
+// The reference: a move as a function of one parameter, sampled densely.
+// ---------------------------------------------------------------------------------------
+
+// The centre's position along the move at s in [0, 1], written from RS-274's definitions,
+// not from toolpath.hpp's frames: G17 angles atan2(y, x) seen from +z, G18 atan2(x, z) seen
+// from +y, G19 atan2(z, y) seen from +x; G3 turns counter-clockwise (increasing angle), the
+// normal coordinate linear in the angle; start == end in the plane is a full circle.
+struct ReferenceMove {
+  SweptMove move;
+  double r = 0.0, a0 = 0.0, sweep = 0.0;
+
+  explicit ReferenceMove(const SweptMove& m) : move(m) {
+    if (m.kind == MoveKind::line) return;
+    const auto [s1, s2] = inPlane(m.start - m.center);
+    const auto [e1, e2] = inPlane(m.end - m.center);
+    r = std::hypot(s1, s2);
+    a0 = std::atan2(s2, s1);
+    double a1 = std::atan2(e2, e1);
+    double turn = m.clockwise ? a0 - a1 : a1 - a0;
+    while (turn <= 0.0) turn += 2.0 * kPi;
+    while (turn > 2.0 * kPi) turn -= 2.0 * kPi;
+    if (s1 == e1 && s2 == e2) turn = 2.0 * kPi;
+    sweep = turn;
+  }
+
+  std::pair<double, double> inPlane(Vec3 d) const {
+    switch (move.plane) {
+      case ArcPlane::xy: return {d.x, d.y};
+      case ArcPlane::zx: return {d.z, d.x};
+      case ArcPlane::yz: return {d.y, d.z};
+    }
+    return {0.0, 0.0};
+  }
+
+  Vec3 at(double s) const {
+    if (move.kind == MoveKind::line) return move.start + s * (move.end - move.start);
+    const double angle = a0 + (move.clockwise ? -1.0 : 1.0) * s * sweep;
+    const double c = r * std::cos(angle), d = r * std::sin(angle);
+    const Vec3 o = move.center;
+    switch (move.plane) {
+      case ArcPlane::xy: return {o.x + c, o.y + d, move.start.z + s * (move.end.z - move.start.z)};
+      case ArcPlane::zx: return {o.x + d, move.start.y + s * (move.end.y - move.start.y), o.z + c};
+      case ArcPlane::yz: return {move.start.x + s * (move.end.x - move.start.x), o.y + c, o.z + d};
+    }
+    return o;
+  }
+};
+
+double ballBottom(Vec3 c, double radius, double x, double y) {
+  const double rho2 = (x - c.x) * (x - c.x) + (y - c.y) * (y - c.y);
+  return rho2 > radius * radius ? kInf : c.z - std::sqrt(radius * radius - rho2);
+}
+
+struct ReferenceValue {
+  double lowest = kInf;
+  double nearest = kInf;  // the least horizontal distance from the samples to (x, y)
+};
+
+// Dense samples, then golden sections about the three best samples.
+ReferenceValue referenceLowest(const SweptMove& move, double radius, double x, double y, int samples) {
+  const ReferenceMove ref(move);
+  ReferenceValue out;
+  std::vector<std::pair<double, int>> values;
+  for (int i = 0; i <= samples; ++i) {
+    const Vec3 c = ref.at(static_cast<double>(i) / samples);
+    out.nearest = std::min(out.nearest, std::hypot(x - c.x, y - c.y));
+    values.push_back({ballBottom(c, radius, x, y), i});
+  }
+  std::partial_sort(values.begin(), values.begin() + std::min<std::ptrdiff_t>(3, std::ssize(values)), values.end());
+  for (int k = 0; k < std::min(3, static_cast<int>(values.size())); ++k) {
+    out.lowest = std::min(out.lowest, values[static_cast<std::size_t>(k)].first);
+    if (!std::isfinite(values[static_cast<std::size_t>(k)].first)) continue;
+    double lo = std::max(0.0, (values[static_cast<std::size_t>(k)].second - 1.0) / samples);
+    double hi = std::min(1.0, (values[static_cast<std::size_t>(k)].second + 1.0) / samples);
+    const double g = (std::sqrt(5.0) - 1.0) / 2.0;
+    auto f = [&](double s) { return ballBottom(ref.at(s), radius, x, y); };
+    double a = hi - g * (hi - lo), b = lo + g * (hi - lo), fa = f(a), fb = f(b);
+    for (int it = 0; it < 100; ++it) {
+      if (fa < fb) {
+        hi = b; b = a; fb = fa; a = hi - g * (hi - lo); fa = f(a);
+      } else {
+        lo = a; a = b; fa = fb; b = lo + g * (hi - lo); fb = f(b);
+      }
+      out.lowest = std::min({out.lowest, fa, fb});
+    }
+  }
+  return out;
+}
+
+// Random moves of every kind, degenerate ones included.
+SweptMove randomMove(std::mt19937_64& rng, double radius) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  auto point = [&] { return Vec3{4.0 * unit(rng), 4.0 * unit(rng), unit(rng)}; };
+  SweptMove m;
+  const int kind = static_cast<int>(rng() % 12);
+  m.start = point();
+  switch (kind) {
+    case 0: case 1: case 2: m.end = point(); break;                                   // general line
+    case 3: m.end = m.start; break;                                                   // zero length
+    case 4: m.end = {m.start.x, m.start.y, unit(rng)}; break;                         // vertical plunge
+    case 5: m.end = m.start + Vec3{1e-9 * unit(rng), -1e-9 * unit(rng), 0.5 * unit(rng) - 0.25}; break;  // nearly vertical
+    case 6: m.end = m.start + Vec3{1e-7 * unit(rng), 1e-7, 0.0}; break;               // tiny
+    case 7: m.end = {m.start.x + 2.0 * unit(rng) - 1.0, m.start.y, m.start.z}; break;  // horizontal
+    default: {
+      m.kind = MoveKind::arc;
+      m.plane = static_cast<ArcPlane>(rng() % 3);
+      m.clockwise = rng() % 2 == 0;
+      const double r = kind == 8 ? 1e-6 + 1e-4 * unit(rng) : radius * 3.0 * unit(rng) + 1e-3;
+      const double a0 = 2.0 * kPi * unit(rng);
+      const double a1 = kind == 9 ? a0 : 2.0 * kPi * unit(rng);  // 9: full circle
+      const double dn = kind == 11 ? unit(rng) - 0.5 : 0.0;        // 11: helix
+      auto offset = [&](double a, double n) -> Vec3 {
+        const double c = r * std::cos(a), d = r * std::sin(a);
+        switch (m.plane) {
+          case ArcPlane::xy: return {c, d, n};
+          case ArcPlane::zx: return {d, n, c};
+          case ArcPlane::yz: return {n, c, d};
+        }
+        return {};
+      };
+      m.center = m.start;
+      m.start = m.center + offset(a0, 0.0);
+      m.end = m.center + offset(a1, dn);
+      // The centre shares the start's normal coordinate.
+      if (m.plane == ArcPlane::xy) m.center.z = m.start.z;
+      if (m.plane == ArcPlane::zx) m.center.y = m.start.y;
+      if (m.plane == ArcPlane::yz) m.center.x = m.start.x;
+    }
+  }
+  return m;
+}
+
+TEST(SweptBall, LowestPointMatchesDenseSamplingOnThousandsOfMoves) {
+  std::mt19937_64 rng(42);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int compared = 0, reached = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    const double radius = 0.05 + 0.95 * unit(rng);
+    const SweptMove move = randomMove(rng, radius);
+    for (int q = 0; q < 6; ++q) {
+      // Points about the move: near its start, its centre, or anywhere nearby.
+      const Vec3 base = q == 0 ? move.start : q == 1 ? move.end : move.kind == MoveKind::arc && q == 2 ? move.center
+                                                                                                   : 0.5 * (move.start + move.end);
+      const double x = base.x + (q == 2 ? 0.0 : (2.0 * unit(rng) - 1.0) * 1.5 * radius);
+      const double y = base.y + (q == 2 ? 0.0 : (2.0 * unit(rng) - 1.0) * 1.5 * radius);
+      const double got = sweptBallLowest(move, radius, x, y);
+      const ReferenceValue want = referenceLowest(move, radius, x, y, 3000);
+      // Grazing contacts at the ball's rim are where sampling cannot decide reach.
+      if (std::abs(want.nearest - radius) < 1e-3 * radius) continue;
+      ++compared;
+      SCOPED_TRACE(testing::Message() << "trial " << trial << " kind " << static_cast<int>(move.kind) << " plane "
+                                      << static_cast<int>(move.plane) << " at (" << x << ", " << y << ") R " << radius);
+      if (!std::isfinite(want.lowest)) {
+        EXPECT_EQ(got, kInf);
+        continue;
+      }
+      ++reached;
+      ASSERT_TRUE(std::isfinite(got));
+      // Never above a genuine position (it finds the minimum) and never below the refined
+      // minimum (no false gouge), up to rounding.
+      const double tolerance = 1e-9 * (1.0 + radius);
+      // A G18/G19 helix is bounded to its documented tolerance above the minimum.
+      const bool verticalHelix = move.kind == MoveKind::arc && move.plane != ArcPlane::xy &&
+                                 toArcPlane(move.plane, move.start).z != toArcPlane(move.plane, move.end).z;
+      const double above = verticalHelix ? kHelixTolerance * (radius + norm(move.center) + norm(move.start - move.center))
+                                         : tolerance;
+      EXPECT_LE(got, want.lowest + above);
+      EXPECT_GE(got, want.lowest - tolerance);
+    }
+  }
+  EXPECT_GT(compared, 15000);
+  EXPECT_GT(reached, 8000);
+}
+
+TEST(SweptBall, DegenerateMovesInClosedForm) {
+  const double radius = 0.5;
+  SweptMove plunge;
+  plunge.start = {1.0, 1.0, 2.0};
+  plunge.end = {1.0, 1.0, 0.5};
+  // Straight down: the lower end's ball.
+  EXPECT_DOUBLE_EQ(sweptBallLowest(plunge, radius, 1.0, 1.0), 0.0);
+  EXPECT_DOUBLE_EQ(sweptBallLowest(plunge, radius, 1.3, 1.0), 0.5 - 0.4);
+  std::swap(plunge.start, plunge.end);  // straight up: the same
+  EXPECT_DOUBLE_EQ(sweptBallLowest(plunge, radius, 1.3, 1.0), 0.5 - 0.4);
+  EXPECT_EQ(sweptBallLowest(plunge, radius, 1.6, 1.0), kInf);
+  SweptMove point;
+  point.start = point.end = {0.0, 0.0, 1.0};
+  EXPECT_DOUBLE_EQ(sweptBallLowest(point, radius, 0.0, 0.3), 1.0 - 0.4);
+  // A horizontal line: a half cylinder, the same depth all along.
+  SweptMove line;
+  line.start = {0.0, 0.0, 1.0};
+  line.end = {2.0, 0.0, 1.0};
+  for (const double x : {0.0, 0.7, 2.0}) EXPECT_DOUBLE_EQ(sweptBallLowest(line, radius, x, 0.3), 0.6);
+  // A ramp rising at 45 degrees, (x, y) on its axis: the ball's bottom lies below the axis
+  // point R / cos 45 down (the cylinder's section is an ellipse), tip at (x, c_z(x) - R sqrt 2).
+  line.end = {2.0, 0.0, 3.0};
+  EXPECT_NEAR(sweptBallLowest(line, radius, 1.0, 0.0), 2.0 - radius * std::sqrt(2.0), 1e-15);
+  // A G18 quarter circle of radius 1 about (0, 0, 0) from (0, 0, -1) (below) to (1, 0, 0):
+  // above x in [0, 1] the ball touches the outer circle of radius 1 + R.
+  SweptMove arc;
+  arc.kind = MoveKind::arc;
+  arc.plane = ArcPlane::zx;
+  arc.center = {0.0, 0.0, 0.0};
+  arc.start = {0.0, 0.0, -1.0};
+  arc.end = {1.0, 0.0, 0.0};
+  // Seen from +y (z right, x up) the short way from -z to +x turns clockwise: G2.
+  arc.clockwise = true;
+  EXPECT_NEAR(sweptBallLowest(arc, radius, 0.6, 0.0), -std::sqrt(1.5 * 1.5 - 0.36), 1e-15);
+  // The other way round (G3) it passes through -x and over the top: lowest where the end
+  // balls are.
+  arc.clockwise = false;
+  EXPECT_NEAR(sweptBallLowest(arc, radius, 0.0, 0.0), -1.5, 1e-15);
+  EXPECT_NEAR(sweptBallLowest(arc, radius, 1.2, 0.0), -std::sqrt(0.25 - 0.04), 1e-15);
+}
+
+// ---------------------------------------------------------------------------------------
+// The z-map on planes: closed forms.
+// ---------------------------------------------------------------------------------------
+
+Surface plane(double size, double z) {
+  BezierPatch patch;
+  patch.degreeU = patch.degreeV = 1;
+  patch.control = {{0.0, 0.0, z}, {size, 0.0, z}, {0.0, size, z}, {size, size, z}};
+  return Surface{Units::inch, {patch}};
+}
+
+SweptMove lineMove(Vec3 a, Vec3 b) {
+  SweptMove m;
+  m.start = a;
+  m.end = b;
+  return m;
+}
+
+TEST(CutSimulation, TwoParallelPassesLeaveTheClosedFormCusp) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int trial = 0; trial < 40; ++trial) {
+    const double radius = 0.1 + 0.4 * unit(rng);
+    const double height = radius * (0.001 + 0.02 * unit(rng));
+    const double l = 2.0 * std::sqrt(2.0 * radius * height - height * height);  // cusp exactly H
+    const double y0 = 1.5 + 0.5 * unit(rng);
+    SimulationOptions options;
+    options.toolRadius = radius;
+    options.scallopHeight = height;
+    options.margin = 0.0;
+    options.stockTop = 0.5 * radius;
+    // Passes along x over the whole plane at tip height 0: centres at z = R.
+    const std::vector<SweptMove> moves = {lineMove({-1.0, y0, radius}, {5.0, y0, radius}),
+                                          lineMove({5.0, y0 + l, radius}, {-1.0, y0 + l, radius})};
+    const Surface surface = plane(4.0, 0.0);
+    const SimulationReport report = simulateCut(surface, moves, options);
+    const HeightGrid& stock = report.stock;
+    double sampledMax = 0.0;
+    for (std::size_t j = 0; j < stock.rows; ++j) {
+      for (std::size_t i = 0; i < stock.columns; ++i) {
+        const Vec2 p = stock.point(i, j);
+        const double dy = std::min(std::abs(p.y - y0), std::abs(p.y - y0 - l));
+        const double want = dy > radius ? options.stockTop.value() : std::min(*options.stockTop, radius - std::sqrt(radius * radius - dy * dy));
+        ASSERT_NEAR(stock.z[j * stock.columns + i], want, 1e-12) << "at " << p.x << ", " << p.y;
+        if (p.y > y0 && p.y < y0 + l) sampledMax = std::max(sampledMax, stock.z[j * stock.columns + i]);
+      }
+    }
+    // The ridge lies between grid rows: the sampled maximum misses it by at most the bound,
+    // which is H / 4 at the default spacing.
+    EXPECT_LE(sampledMax, height + 1e-12);
+    EXPECT_GE(sampledMax, height - report.heightErrorBound - 1e-12);
+    EXPECT_NEAR(report.heightErrorBound, 0.25 * height, 1e-12 * height);
+    EXPECT_EQ(report.maxGouge, 0.0);
+    EXPECT_EQ(report.gougePoints, 0u);
+    EXPECT_NEAR(report.maxScallop, *options.stockTop, 1e-12);  // beyond the passes: uncut stock
+  }
+}
+
+TEST(CutSimulation, APlungeBelowThePlaneIsAGougeOfItsDepth) {
+  const double radius = 0.25, depth = 0.1;
+  SimulationOptions options;
+  options.toolRadius = radius;
+  options.scallopHeight = 0.001;
+  options.resolution = 0.01;
+  options.margin = 0.0;
+  SweptMove plunge = lineMove({2.0, 2.0, 2.0}, {2.0, 2.0, radius - depth});
+  const SimulationReport report = simulateCut(plane(4.0, 0.0), {plunge}, options);
+  EXPECT_NEAR(report.maxGouge, depth, 1e-12);
+  ASSERT_TRUE(report.maxGougeAt.has_value());
+  EXPECT_NEAR(report.maxGougeAt->x, 2.0, 1e-9);
+  EXPECT_NEAR(report.maxGougeAt->y, 2.0, 1e-9);
+  // The gouged points: the ball's bottom R - sqrt(R^2 - rho^2) - depth below 0 by more than
+  // the tolerance, counted on the grid here.
+  std::size_t want = 0;
+  for (std::size_t j = 0; j < report.stock.rows; ++j) {
+    for (std::size_t i = 0; i < report.stock.columns; ++i) {
+      const Vec2 p = report.stock.point(i, j);
+      const double rho2 = (p.x - 2.0) * (p.x - 2.0) + (p.y - 2.0) * (p.y - 2.0);
+      if (rho2 < radius * radius && depth - (radius - std::sqrt(radius * radius - rho2)) > report.gougeTolerance) ++want;
+    }
+  }
+  EXPECT_EQ(report.gougePoints, want);
+  EXPECT_GT(want, 1000u);
+  EXPECT_NEAR(report.gougeArea, static_cast<double>(want) * 1e-4, 1e-12);
+  // The plunge started in the air above the stock (the plane's top): the stock elsewhere is
+  // uncut, scallop = 0 exactly there as the stock top is the plane.
+  EXPECT_EQ(report.maxScallop, 0.0);
+}
+
+TEST(CutSimulation, SweepEqualsTheLowestOfEveryMoveAtEveryPoint) {
+  // The sweep's pruning (boxes, the stock already lower than the move can reach) loses
+  // nothing: the z-map equals min(stock top, every move's lowest point) bit for bit.
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int trial = 0; trial < 10; ++trial) {
+    const double radius = 0.1 + 0.5 * unit(rng);
+    std::vector<SweptMove> moves;
+    for (int k = 0; k < 40; ++k) {
+      SweptMove m = randomMove(rng, radius);
+      if (k % 10 == 0) {  // some far outside the grid
+        m.start.x += 10.0;
+        m.end.x += 10.0;
+        m.center.x += 10.0;
+      }
+      m.rapid = k % 7 == 0;
+      moves.push_back(m);
+    }
+    HeightGrid stock;
+    stock.x0 = -0.3;
+    stock.y0 = 0.2;
+    stock.spacing = 0.075;
+    stock.columns = 60;
+    stock.rows = 50;
+    stock.z.assign(stock.columns * stock.rows, 0.8);
+    std::vector<double> lowered;
+    sweepMoves(moves, radius, stock, &lowered);
+    for (std::size_t j = 0; j < stock.rows; ++j) {
+      for (std::size_t i = 0; i < stock.columns; ++i) {
+        const Vec2 p = stock.point(i, j);
+        double want = 0.8;
+        for (const SweptMove& m : moves) want = std::min(want, sweptBallLowest(m, radius, p.x, p.y));
+        ASSERT_EQ(stock.z[j * stock.columns + i], want) << "trial " << trial << " point " << i << ", " << j;
+      }
+    }
+    for (std::size_t k = 0; k < moves.size(); k += 10) EXPECT_EQ(lowered[k], 0.0);  // outside
+  }
+}
+
+// ---------------------------------------------------------------------------------------
+// The design surface seen from above.
+// ---------------------------------------------------------------------------------------
+
+// The visible height by a triangle mesh of (n + 1)^2 samples: the highest triangle over
+// each grid point, linearly interpolated.
+struct MeshReference {
+  std::vector<double> z;
+};
+
+MeshReference meshHeights(const Surface& surface, const HeightGrid& grid, int n) {
+  MeshReference out;
+  out.z.assign(grid.z.size(), -kInf);
+  for (const BezierPatch& patch : surface.patches) {
+    std::vector<Vec3> s;
+    for (int a = 0; a <= n; ++a)
+      for (int b = 0; b <= n; ++b) s.push_back(point(patch, static_cast<double>(a) / n, static_cast<double>(b) / n));
+    auto at = [&](int a, int b) { return s[static_cast<std::size_t>(a * (n + 1) + b)]; };
+    auto triangle = [&](Vec3 p, Vec3 q, Vec3 r) {
+      const double x0 = std::min({p.x, q.x, r.x}), x1 = std::max({p.x, q.x, r.x});
+      const double y0 = std::min({p.y, q.y, r.y}), y1 = std::max({p.y, q.y, r.y});
+      const double det = (q.x - p.x) * (r.y - p.y) - (r.x - p.x) * (q.y - p.y);
+      if (det == 0.0) return;
+      for (long j = std::max(0L, static_cast<long>(std::ceil((y0 - grid.y0) / grid.spacing)));
+           j <= std::min(static_cast<long>(grid.rows) - 1, static_cast<long>(std::floor((y1 - grid.y0) / grid.spacing))); ++j) {
+        for (long i = std::max(0L, static_cast<long>(std::ceil((x0 - grid.x0) / grid.spacing)));
+             i <= std::min(static_cast<long>(grid.columns) - 1, static_cast<long>(std::floor((x1 - grid.x0) / grid.spacing))); ++i) {
+          const Vec2 g = grid.point(static_cast<std::size_t>(i), static_cast<std::size_t>(j));
+          const double l1 = ((g.x - p.x) * (r.y - p.y) - (r.x - p.x) * (g.y - p.y)) / det;
+          const double l2 = ((q.x - p.x) * (g.y - p.y) - (g.x - p.x) * (q.y - p.y)) / det;
+          if (l1 < 0.0 || l2 < 0.0 || l1 + l2 > 1.0) continue;
+          double& z = out.z[static_cast<std::size_t>(j) * grid.columns + static_cast<std::size_t>(i)];
+          z = std::max(z, p.z + l1 * (q.z - p.z) + l2 * (r.z - p.z));
+        }
+      }
+    };
+    for (int a = 0; a < n; ++a) {
+      for (int b = 0; b < n; ++b) {
+        triangle(at(a, b), at(a + 1, b), at(a + 1, b + 1));
+        triangle(at(a, b), at(a + 1, b + 1), at(a, b + 1));
+      }
+    }
+  }
+  return out;
+}
+
+// Within `band` of the xy image of a patch's boundary (sampled).
+bool nearBoundary(const Surface& surface, Vec2 p, double band) {
+  for (const BezierPatch& patch : surface.patches) {
+    for (int k = 0; k < 400; ++k) {
+      const double t = k / 400.0, t1 = (k + 1) / 400.0;
+      auto flat = [](Vec3 q) { return Vec2{q.x, q.y}; };
+      const Vec2 edges[4][2] = {{flat(point(patch, t, 0.0)), flat(point(patch, t1, 0.0))},
+                                {flat(point(patch, t, 1.0)), flat(point(patch, t1, 1.0))},
+                                {flat(point(patch, 0.0, t)), flat(point(patch, 0.0, t1))},
+                                {flat(point(patch, 1.0, t)), flat(point(patch, 1.0, t1))}};
+      for (const auto& edge : edges)
+        if (distanceToSegment(p, edge[0], edge[1]) < band) return true;
+    }
+  }
+  return false;
+}
+
+void expectDesignMatchesMesh(const Surface& surface, double spacing, double tolerance, const std::string& name) {
+  SimulationOptions options;
+  options.toolRadius = 0.25;
+  options.scallopHeight = 0.001;
+  options.resolution = spacing;
+  HeightGrid grid = simulationGrid(surface, options);
+  designHeights(surface, grid);
+  const MeshReference mesh = meshHeights(surface, grid, 400);
+  std::size_t inside = 0;
+  for (std::size_t j = 0; j < grid.rows; ++j) {
+    for (std::size_t i = 0; i < grid.columns; ++i) {
+      const std::size_t k = j * grid.columns + i;
+      const Vec2 p = grid.point(i, j);
+      if (std::isfinite(mesh.z[k])) {
+        ++inside;
+        ASSERT_TRUE(std::isfinite(grid.z[k])) << name << ": no surface found at " << p.x << ", " << p.y;
+        ASSERT_NEAR(grid.z[k], mesh.z[k], tolerance) << name << " at " << p.x << ", " << p.y;
+      } else if (std::isfinite(grid.z[k])) {
+        // Off the mesh: only where the true boundary bulges past the chords.
+        ASSERT_TRUE(nearBoundary(surface, p, 1e-4)) << name << ": surface claimed at " << p.x << ", " << p.y;
+      }
+    }
+  }
+  EXPECT_GT(inside, grid.z.size() / 4) << name;
+}
+
+TEST(DesignHeights, RandomGraphPatchesAgainstADenseMesh) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int trial = 0; trial < 12; ++trial) {
+    BezierPatch patch;
+    patch.degreeU = 1 + static_cast<int>(rng() % 4);
+    patch.degreeV = 1 + static_cast<int>(rng() % 4);
+    for (int j = 0; j <= patch.degreeU; ++j) {
+      for (int k = 0; k <= patch.degreeV; ++k) {
+        // A perturbed (then rotated) grid: one-to-one over xy; heights up to 1.
+        const double x = 2.0 * k / patch.degreeV + 0.15 * (unit(rng) - 0.5);
+        const double y = 2.0 * j / patch.degreeU + 0.15 * (unit(rng) - 0.5);
+        patch.control.push_back({0.8 * x - 0.6 * y, 0.6 * x + 0.8 * y, unit(rng)});
+      }
+    }
+    const Surface surface{Units::inch, {patch}};
+    validateSurface(surface);
+    expectDesignMatchesMesh(surface, 0.02, 2e-4, "trial " + std::to_string(trial));
+  }
+}
+
+TEST(DesignHeights, AnOverhangShowsItsHighestSheet) {
+  // A degree (1, 3) patch whose xz profile is an S: over x in its middle the vertical line
+  // meets three sheets; a 3-axis mill sees the top one.
+  BezierPatch patch;
+  patch.degreeU = 1;
+  patch.degreeV = 3;
+  const std::vector<Vec2> profile = {{0.0, 0.0}, {3.0, 0.3}, {-1.0, 0.7}, {2.0, 1.0}};
+  for (int j = 0; j <= 1; ++j)
+    for (const Vec2& q : profile) patch.control.push_back({q.x, 2.0 * j, q.y});
+  const Surface surface{Units::inch, {patch}};
+  expectDesignMatchesMesh(surface, 0.02, 2e-3, "overhang");
+}
+
+TEST(DesignHeights, AVerticalWallOnAGridLineEndsWithinItsBudget) {
+  // A wall x = 0 (its xy image a segment on the grid column through x = 0, the Jacobian zero
+  // everywhere) beside a floor z = 0.5: every cell over the wall is a fold cell; the
+  // quadtree stops at 4 points a cell (in a fraction of a second), and the floor is seen
+  // everywhere off the wall.
+  BezierPatch wall;
+  wall.degreeU = wall.degreeV = 1;
+  wall.control = {{0.0, 0.0, 0.0}, {0.0, 0.0, 1.0}, {0.0, 2.0, 0.0}, {0.0, 2.0, 1.0}};
+  const Surface surface{Units::inch, {wall, plane(2.0, 0.5).patches[0]}};
+  SimulationOptions options;
+  options.toolRadius = 0.25;
+  options.scallopHeight = 0.001;
+  options.resolution = 1.0 / 256.0;
+  HeightGrid grid = simulationGrid(surface, options);
+  designHeights(surface, grid);
+  std::size_t floor = 0;
+  for (std::size_t j = 0; j < grid.rows; ++j) {
+    for (std::size_t i = 0; i < grid.columns; ++i) {
+      const Vec2 p = grid.point(i, j);
+      if (p.x >= 0.0 && p.x <= 2.0 && p.y >= 0.0 && p.y <= 2.0) {
+        const double z = grid.z[j * grid.columns + i];
+        if (p.x == 0.0) {  // on the wall: the floor or a point of the wall (the contract)
+          ASSERT_GE(z, 0.5);
+          ASSERT_LE(z, 1.0);
+        } else {
+          ASSERT_EQ(z, 0.5) << p.x << ", " << p.y;
+        }
+        ++floor;
+      }
+    }
+  }
+  EXPECT_EQ(floor, 513u * 513u);
+}
+
+TEST(DesignHeights, ThePaperSurfacesAgainstADenseMesh) {
+  for (const std::string name : {"paper-1", "paper-2"}) expectDesignMatchesMesh(exampleSurface(name), 0.02, 1e-4, name);
+}
+
+// ---------------------------------------------------------------------------------------
+// Programs, tool paths and the paper's plans.
+// ---------------------------------------------------------------------------------------
+
+GcodeOptions programOptions() {
+  GcodeOptions options;
+  options.safeHeight = 2.0;
+  options.feedRate = 40.0;
+  options.plungeFeedRate = 15.0;
+  options.spindleRpm = 10000.0;
+  return options;
+}
+
+TEST(CutSimulation, AProgramCutsAsItsToolPathUpToTheGcodeRounding) {
+  // A raster along x writes exact G18 arcs. Every ball centre of the program lies within
+  // delta of one of the path's (rounding to q / 2 per axis, q = 0.00001 in, of the ends and
+  // the arcs' centres; arcs of tiny sagitta as lines, polygons within q), so the balls of
+  // radius R - delta about the path's centres lie inside the program's swept balls, and
+  // those lie inside the balls of radius R + delta: the z-maps nest point by point. (The
+  // program's plunges and retracts run straight down to and up from the passes' ends.)
+  const Surface surface = exampleSurface("paper-1");
+  RasterOptions raster;
+  raster.angleRad = 0.0;
+  raster.toolRadius = 0.25;
+  raster.scallopHeight = 0.002;
+  raster.dropEnvelope = false;  // the hull's exact G18 arcs (lifting replaces them)
+  const RasterPaths paths = rasterPaths(surface, raster);
+  const GcodeProgram program = parseGcodeProgram(gcodeProgram(paths.path, programOptions()), "raster.ngc");
+  std::size_t arcs = 0;
+  for (const ProgramMove& m : program.moves) arcs += m.kind == ProgramMoveKind::arc;
+  EXPECT_GT(arcs, 100u);
+  const double delta = 3e-5;
+  SimulationOptions options;
+  options.scallopHeight = 0.002;
+  options.toolRadius = 0.25;
+  options.resolution = 0.008;  // the same grid for the three radii
+  const SimulationReport fromProgram = verifyProgram(surface, program, options);
+  options.toolRadius = 0.25 + delta;
+  const SimulationReport outer = verifyToolPath(surface, paths.path, options);
+  options.toolRadius = 0.25 - delta;
+  const SimulationReport inner = verifyToolPath(surface, paths.path, options);
+  ASSERT_EQ(outer.stock.z.size(), fromProgram.stock.z.size());
+  std::size_t outside = 0, close = 0;
+  for (std::size_t k = 0; k < outer.stock.z.size(); ++k) {
+    if (!(outer.stock.z[k] <= fromProgram.stock.z[k] + 1e-12 && fromProgram.stock.z[k] <= inner.stock.z[k] + 1e-12))
+      ++outside;
+    if (std::abs(outer.stock.z[k] - inner.stock.z[k]) < 1e-4) ++close;
+  }
+  EXPECT_EQ(outside, 0u);
+  // Not vacuous: the bounds are within 1e-4 of each other on 98.9 % of the points (all but
+  // those under the steep rims of the balls, where 2 delta of radius moves the height most).
+  EXPECT_GT(close, outer.stock.z.size() * 95 / 100) << close << " of " << outer.stock.z.size();
+  EXPECT_EQ(fromProgram.rapidsCutting, 0u);
+}
+
+TEST(CutSimulation, FindsTheRasterPlansGougeOnPaper1) {
+  // gouge.hpp measures the ball's interference delta = R - distance to the surface; the
+  // vertical gouge above the nearest surface point is at least delta (cut_simulation.hpp),
+  // so the z-map must show at least delta, less what a grid point beside the deepest one
+  // can miss (the gouge's slope, at most ~2 here, times d).
+  const Surface surface = exampleSurface("paper-1");
+  RasterOptions raster;
+  raster.bestAngle = true;
+  raster.toolRadius = 0.25;
+  raster.scallopHeight = 0.001;
+  raster.dropEnvelope = false;  // the in-plane hull's paths, which gouge (issue 13)
+  const RasterPaths paths = rasterPaths(surface, raster);
+  const GougeReport check = gougeCheck(surface, paths.path, raster.toolRadius / 10.0);
+  ASSERT_GT(check.maxDepth, 0.15);
+  SimulationOptions options;
+  options.toolRadius = 0.25;
+  options.scallopHeight = 0.001;
+  const SimulationReport report =
+      verifyProgram(surface, parseGcodeProgram(gcodeProgram(paths.path, programOptions()), "p1.ngc"), options);
+  EXPECT_GE(report.maxGouge, check.maxDepth - 2.0 * report.design.spacing);
+  EXPECT_GT(report.gougePoints, 1000u);
+  // Where the check found its deepest interference, the z-map shows a gouge too.
+  const Vec3 contact = check.deepest.contact.point;
+  const auto i = static_cast<std::size_t>(std::lround((contact.x - report.design.x0) / report.design.spacing));
+  const auto j = static_cast<std::size_t>(std::lround((contact.y - report.design.y0) / report.design.spacing));
+  double nearby = 0.0;
+  for (std::size_t b = j - 2; b <= j + 2; ++b)
+    for (std::size_t a = i - 2; a <= i + 2; ++a)
+      if (a < report.design.columns && b < report.design.rows)
+        nearby = std::max(nearby, report.design.z[b * report.design.columns + a] - report.stock.z[b * report.design.columns + a]);
+  EXPECT_GE(nearby, check.maxDepth - 4.0 * report.design.spacing);
+}
+
+TEST(CutSimulation, FindsTheContourPlansGougeOnPaper2WithALargeBall) {
+  const Surface surface = exampleSurface("paper-2");
+  const OptimalSlicing orientation = optimalSlicing(surface);
+  ContourOptions contour;
+  contour.normal = orientation.normal;
+  contour.toolRadius = 1.0;
+  contour.spacing = spacingForScallopHeight(1.0, 0.001, orientation.certifiedAlphaRad);
+  contour.dropEnvelope = false;  // the centres r + R n, which cut in (issue 13: about 0.2 in)
+  const ContourPaths paths = contourPaths(surface, contour);
+  const GougeReport check = gougeCheck(surface, paths.path, contour.toolRadius / 10.0);
+  ASSERT_GT(check.maxDepth, 0.1);
+  SimulationOptions options;
+  options.toolRadius = 1.0;
+  options.scallopHeight = 0.001;
+  const SimulationReport report = verifyToolPath(surface, paths.path, options);
+  EXPECT_GE(report.maxGouge, check.maxDepth - 2.0 * report.design.spacing);
+}
+
+TEST(CutSimulation, ScallopOfAContourPlanOnAPlaneIsTheClosedForm) {
+  // Horizontal planes z = k Delta cut an inclined plane in parallel lines; balls on them
+  // leave cusps of the flat-surface height: max scallop within the grid's bound of
+  // R - sqrt(R^2 - l^2 / 4), l the lines' distance, and no gouge.
+  const double radius = 0.25, height = 0.002;
+  BezierPatch patch;
+  patch.degreeU = patch.degreeV = 1;
+  patch.control = {{0.0, 0.0, 0.0}, {2.0, 0.0, 0.0}, {0.0, 2.0, 1.0}, {2.0, 2.0, 1.0}};
+  const Surface surface{Units::inch, {patch}};
+  // The angle theta between z and the plane's normal (0, -1/2, 1) / sqrt(1.25).
+  const double sinAlpha = 0.5 / std::sqrt(1.25), cosAlpha = 1.0 / std::sqrt(1.25);
+  ContourOptions contour;
+  contour.normal = {0.0, 0.0, 1.0};
+  contour.toolRadius = radius;
+  contour.spacing = spacingForScallopHeight(radius, height, std::asin(sinAlpha));
+  const ContourPaths paths = contourPaths(surface, contour);
+  SimulationOptions options;
+  options.toolRadius = radius;
+  options.scallopHeight = height;
+  const SimulationReport report = verifyToolPath(surface, paths.path, options);
+  EXPECT_LE(report.maxGouge, 1e-12);
+  // Between the first and last lines (away from the edges, where stock is left).
+  double inner = 0.0;
+  for (std::size_t j = 0; j < report.stock.rows; ++j) {
+    for (std::size_t i = 0; i < report.stock.columns; ++i) {
+      const Vec2 p = report.stock.point(i, j);
+      if (p.x < 0.3 || p.x > 1.7 || p.y < 0.3 || p.y > 1.7) continue;
+      const std::size_t k = j * report.stock.columns + i;
+      // The scallop along the normal: the vertical difference times n_z.
+      inner = std::max(inner, (report.stock.z[k] - report.design.z[k]) * cosAlpha);
+      ASSERT_NEAR(report.designNormalZ[k], cosAlpha, 1e-12);
+    }
+  }
+  const double l = contour.spacing / sinAlpha;
+  const double cusp = radius - std::sqrt(radius * radius - 0.25 * l * l);
+  EXPECT_NEAR(cusp, height, 1e-9);
+  EXPECT_LE(inner, cusp + 1e-9);
+  // A ridge across the slope lies within d / (2 cos theta) of a grid point along the surface.
+  EXPECT_GE(inner, cusp - report.heightErrorBound / cosAlpha);
+}
+
+TEST(CutSimulation, TranslatingSurfaceAndMovesTogetherChangesNothing) {
+  // Moved by a vector whose components are multiples of the grid spacing (powers of two, so
+  // every coordinate moves exactly), the grid moves with the surface's box and each point's
+  // stock and design move by dz: gouges and scallops stay the same up to rounding.
+  std::mt19937_64 rng(19);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  BezierPatch patch;
+  patch.degreeU = patch.degreeV = 3;
+  for (int j = 0; j <= 3; ++j)
+    for (int k = 0; k <= 3; ++k) patch.control.push_back({k + 0.1 * unit(rng), j + 0.1 * unit(rng), 0.3 * unit(rng)});
+  const Surface surface{Units::inch, {patch}};
+  std::vector<SweptMove> moves;
+  for (int k = 0; k < 200; ++k) {
+    SweptMove m = randomMove(rng, 0.25);
+    m.start.z -= 0.3;
+    m.end.z -= 0.3;
+    m.center.z -= 0.3;
+    moves.push_back(m);
+  }
+  SimulationOptions options;
+  options.toolRadius = 0.25;
+  options.scallopHeight = 0.001;
+  options.resolution = 1.0 / 64.0;
+  const SimulationReport before = simulateCut(surface, moves, options);
+  const Vec3 shift{2.0, -1.5, 0.75};
+  Surface moved = surface;
+  for (Vec3& c : moved.patches[0].control) c = c + shift;
+  std::vector<SweptMove> movedMoves = moves;
+  for (SweptMove& m : movedMoves) {
+    m.start = m.start + shift;
+    m.end = m.end + shift;
+    m.center = m.center + shift;
+  }
+  const SimulationReport after = simulateCut(moved, movedMoves, options);
+  ASSERT_EQ(before.design.columns, after.design.columns);
+  ASSERT_EQ(before.design.rows, after.design.rows);
+  EXPECT_GT(before.maxGouge, 0.01);  // the moves dip into the surface
+  EXPECT_NEAR(before.maxGouge, after.maxGouge, 1e-9);
+  EXPECT_NEAR(before.maxScallop, after.maxScallop, 1e-9);
+  EXPECT_NEAR(before.scallopP99, after.scallopP99, 1e-9);
+  EXPECT_EQ(before.surfacePoints, after.surfacePoints);
+  // Counts at thresholds may flip only for values within rounding of the threshold.
+  EXPECT_NEAR(static_cast<double>(before.gougePoints), static_cast<double>(after.gougePoints), 2.0);
+}
+
+TEST(CutSimulation, OptionsAndBudgetsAreCheckedWithClearErrors) {
+  const Surface surface = plane(4.0, 0.0);
+  SimulationOptions options;
+  options.toolRadius = 0.25;
+  options.scallopHeight = 0.001;
+  options.resolution = 1e-4;  // 40,000 x 40,000 points
+  try {
+    simulateCut(surface, {}, options);
+    FAIL() << "accepted a grid over the budget";
+  } catch (const Error& error) {
+    EXPECT_NE(std::string(error.what()).find("more than the budget of 4000000"), std::string::npos) << error.what();
+  }
+  options.resolution = 0.0;
+  options.scallopHeight = 0.3;
+  EXPECT_THROW(simulateCut(surface, {}, options), Error);
+  options.scallopHeight = 0.001;
+  options.toolRadius = -1.0;
+  EXPECT_THROW(simulateCut(surface, {}, options), Error);
+  options.toolRadius = 0.25;
+  SweptMove bad = lineMove({0.0, 0.0, 0.0}, {std::nan(""), 0.0, 0.0});
+  bad.line = 17;
+  try {
+    simulateCut(surface, {bad}, options);
+    FAIL() << "accepted a NaN move";
+  } catch (const Error& error) {
+    EXPECT_NE(std::string(error.what()).find("line 17"), std::string::npos) << error.what();
+  }
+  // The sweep's budget is counted before sweeping.
+  std::vector<SweptMove> many(2000, lineMove({-1.0, -1.0, 0.3}, {5.0, 5.0, 0.3}));
+  options.maxEvaluations = 1e8;
+  try {
+    simulateCut(surface, many, options);
+    FAIL() << "accepted a sweep over the budget";
+  } catch (const Error& error) {
+    EXPECT_NE(std::string(error.what()).find("more than the budget of 1e+08"), std::string::npos) << error.what();
+  }
+  options.maxEvaluations = 4e9;
+  // An empty program: the stock stays at the surface's top; nothing is gouged.
+  const SimulationReport report = simulateCut(surface, {}, options);
+  EXPECT_EQ(report.maxGouge, 0.0);
+  EXPECT_EQ(report.uncutPoints, 0u);  // the plane's top is its bounding box's top
+}
+
+TEST(VerifyOutput, JsonHasNoNanAndTheSvgStaysSmall) {
+  const Surface surface = exampleSurface("paper-1");
+  RasterOptions raster;
+  raster.bestAngle = true;
+  raster.toolRadius = 0.25;
+  raster.scallopHeight = 0.001;
+  raster.dropEnvelope = false;  // a path that gouges, for the report's gouge fields
+  const RasterPaths paths = rasterPaths(surface, raster);
+  SimulationOptions options;
+  options.toolRadius = 0.25;
+  options.scallopHeight = 0.001;
+  const SimulationReport report = verifyToolPath(surface, paths.path, options);
+  const std::string json = verifyToJson(report, {"example paper-1", "p.ngc", 0, 0.0});
+  EXPECT_EQ(json.find("nan"), std::string::npos);
+  EXPECT_EQ(json.find("inf"), std::string::npos);
+  EXPECT_NE(json.find("\"over_tolerance\": true"), std::string::npos);
+  const std::string svg = verifySvg(report, {"example <paper-1>", "p.ngc", 0, 0.0});
+  EXPECT_LT(svg.size(), 1'500'000u);
+  EXPECT_NE(svg.find("example &lt;paper-1&gt;"), std::string::npos);
+  EXPECT_NE(svg.find("deepest gouge"), std::string::npos);
+  EXPECT_EQ(svg.find("nan"), std::string::npos);
+  // Deterministic.
+  EXPECT_EQ(svg, verifySvg(report, {"example <paper-1>", "p.ngc", 0, 0.0}));
+}
+
+}  // namespace
+}  // namespace scallop
