@@ -9,6 +9,7 @@
 //   stereographic.svg   the stereographic plane with the medial axis and the optimal circle
 // Everything is computed first; the folder is written all or nothing.
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -23,11 +24,14 @@
 #include "arguments.hpp"
 #include "commands.hpp"
 #include "output_directory.hpp"
+#include "scallop/cut_simulation.hpp"
 #include "scallop/error.hpp"
 #include "scallop/gcode.hpp"
+#include "scallop/gcode_reader.hpp"
 #include "scallop/optimal_slicing.hpp"
 #include "scallop/orient_output.hpp"
 #include "scallop/paths_output.hpp"
+#include "scallop/verify_output.hpp"
 #include "scallop/surface.hpp"
 #include "surface_options.hpp"
 #include "linking_options.hpp"
@@ -104,10 +108,32 @@ void runPlan(const PlanOptions& options) {
   report.feedRate = gcodeOptions.feedRate;
   report.plungeFeedRate = gcodeOptions.plungeFeedRate;
   report.rapidRate = rapidRate;
+  const std::string programName = dialect == GcodeDialect::grbl ? "toolpath.gcode" : "toolpath.ngc";
+  const std::string program = gcodeProgram(result.path, gcodeOptions);
+  // The program as written, read back and cut in simulation (scallop verify): the finishing
+  // stock is the surface raised by half the links' clearance (what they assume roughing
+  // left), the scallop height the one asked (or the flat-surface one of the spacing given).
+  progress("simulating the cut of the program (scallop verify)");
+  SimulationOptions simulation;
+  simulation.toolRadius = job.toolRadius;
+  simulation.scallopHeight = job.scallopHeight
+                                 ? *job.scallopHeight
+                                 : job.toolRadius - std::sqrt(job.toolRadius * job.toolRadius -
+                                                              0.25 * report.spacing * report.spacing);
+  simulation.stockAllowance = report.linking ? 0.5 * report.linking->clearance : (inch ? 0.01 : 0.25);
+  const SimulationReport simulated =
+      verifyProgram(surface, parseGcodeProgram(program, programName), simulation);
+  report.verification = VerificationSummary{simulated.design.spacing, simulated.heightErrorBound,
+                                            *simulation.stockAllowance, simulated.maxGouge,
+                                            simulated.maxGougeAt, simulated.gougeArea,
+                                            simulated.gougeTolerance, simulated.maxScallop,
+                                            simulated.maxScallopAt, simulated.scallopP99,
+                                            simulated.meanScallop, simulated.uncutArea,
+                                            simulated.rapidsCutting, simulated.seconds};
   std::vector<OutputFile> outputs{
-      {(dir / (dialect == GcodeDialect::grbl ? "toolpath.gcode" : "toolpath.ngc")).string(),
-       gcodeProgram(result.path, gcodeOptions)},
+      {(dir / programName).string(), program},
       {(dir / "report.json").string(), pathsToJson(report, result.path)},
+      {(dir / "verify.svg").string(), verifySvg(simulated, {source, programName, 0, 0.0})},
       {(dir / "paths.svg").string(), pathsSvg(surface, result.contactCurves, result.path, figureTitle, false)},
       {(dir / "paths-plan.svg").string(), pathsSvg(surface, result.contactCurves, result.path, figureTitle, true)},
       {(dir / "gauss-map.svg").string(), gaussMapSphereSvg(orientation)},
@@ -130,7 +156,11 @@ void runPlan(const PlanOptions& options) {
              options.strategy, source, orientation.normal.x, orientation.normal.y,
              orientation.normal.z, orientation.alphaRad * 180.0 / std::numbers::pi, report.spacing,
              s.planes, s.components, s.centreLength, unitsName(surface.units), gouge,
-             cycleSummary(report, surface.units), report.seconds + orientation.seconds,
+             cycleSummary(report, surface.units) +
+                 fmt::format("; simulated: gouge {:.6f}, scallop max {:.6f} / 99% {:.6f} {}",
+                             simulated.maxGouge, simulated.maxScallop, simulated.scallopP99,
+                             unitsName(surface.units)),
+             report.seconds + orientation.seconds,
              options.out);
 }
 
@@ -143,7 +173,8 @@ void addPlanCommand(CLI::App& app) {
   plan->footer(
       "With no arguments: the paper's test surface 1 (inches), a 0.25 in ball, a 0.001 in "
       "scallop height, the contour strategy on the optimal planes N*; writes toolpath.ngc, "
-      "report.json, paths.svg, paths-plan.svg, gauss-map.svg and stereographic.svg into "
+      "report.json (with the simulated cut of the program), verify.svg (its heat map), "
+      "paths.svg, paths-plan.svg, gauss-map.svg and stereographic.svg into "
       "scallop-out/ (or --out DIR), all or nothing.");
   addSurfaceSourceOptions(*plan, options->surface, "surface file (JSON or .bpt); - reads standard input",
                           "a built-in example (default paper-1)");

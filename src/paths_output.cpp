@@ -158,6 +158,25 @@ std::string pathsToJson(const PathsReport& report, const ToolPath& path) {
   } else {
     document["envelope"] = nullptr;
   }
+  if (report.verification) {
+    const VerificationSummary& v = *report.verification;
+    Json verification;
+    verification["grid_spacing"] = v.gridSpacing;
+    verification["height_error_bound"] = v.heightErrorBound;
+    verification["stock_allowance"] = v.stockAllowance;
+    verification["max_gouge"] = v.maxGouge;
+    verification["max_gouge_at"] = v.maxGougeAt ? vec(*v.maxGougeAt) : Json(nullptr);
+    verification["gouge_area"] = v.gougeArea;
+    verification["gouge_tolerance"] = v.gougeTolerance;
+    verification["max_scallop"] = v.maxScallop;
+    verification["max_scallop_at"] = v.maxScallopAt ? vec(*v.maxScallopAt) : Json(nullptr);
+    verification["scallop_p99"] = v.scallopP99;
+    verification["mean_scallop"] = v.meanScallop;
+    verification["uncut_area"] = v.uncutArea;
+    verification["rapids_cutting"] = v.rapidsCutting;
+    verification["seconds"] = v.seconds;
+    document["verification"] = std::move(verification);
+  }
   if (report.gouge) {
     Json gouge;
     gouge["max_depth"] = report.gouge->maxDepth;

@@ -55,8 +55,16 @@ TEST_F(PathsCli, PlanWithNoArgumentsWritesTheWholeFolder) {
     files.push_back(entry.path().filename().string());
   std::sort(files.begin(), files.end());
   EXPECT_EQ(files, (std::vector<std::string>{"gauss-map.svg", "paths-plan.svg", "paths.svg",
-                                             "report.json", "stereographic.svg", "toolpath.ngc"}));
+                                             "report.json", "stereographic.svg", "toolpath.ngc",
+                                             "verify.svg"}));
   const auto report = nlohmann::json::parse(readFile(workDir_ / "scallop-out" / "report.json"));
+  // The simulated cut of the program as written: no gouge beyond the G-code's rounding
+  // (1e-5 in quanta), no rapid into the finishing stock, a heat map with its colour bar.
+  const auto& verification = report["verification"];
+  EXPECT_LT(verification["max_gouge"].get<double>(), 1e-4);
+  EXPECT_EQ(verification["rapids_cutting"].get<int>(), 0);
+  EXPECT_GT(verification["max_scallop"].get<double>(), 0.0);
+  EXPECT_NE(readFile(workDir_ / "scallop-out" / "verify.svg").find("scallop (in)"), std::string::npos);
   EXPECT_EQ(report["strategy"], "contour");
   EXPECT_EQ(report["units"], "in");
   EXPECT_EQ(report["tool_radius"], 0.25);

@@ -37,6 +37,24 @@ struct OrientationSummary {
   double seconds = 0.0;
 };
 
+/// `scallop plan`'s simulation of its own program (cut_simulation.hpp), in short.
+struct VerificationSummary {
+  double gridSpacing = 0.0;
+  double heightErrorBound = 0.0;  ///< how much a scallop ridge can hide between grid points
+  double stockAllowance = 0.0;    ///< the finishing stock: the surface raised by this
+  double maxGouge = 0.0;          ///< vertical, at grid points
+  std::optional<Vec3> maxGougeAt;
+  double gougeArea = 0.0;         ///< beyond the gouge tolerance
+  double gougeTolerance = 0.0;
+  double maxScallop = 0.0;
+  std::optional<Vec3> maxScallopAt;
+  double scallopP99 = 0.0;
+  double meanScallop = 0.0;
+  double uncutArea = 0.0;         ///< scallop above H
+  std::size_t rapidsCutting = 0;
+  double seconds = 0.0;
+};
+
 struct PathsReport {
   std::string strategy;            ///< "contour" or "raster"
   std::string source;              ///< the surface's file or example name
@@ -58,6 +76,8 @@ struct PathsReport {
   double gougeSampleSpacing = 0.0;   ///< the spacing the gouge check sampled at
   std::optional<OrientationSummary> orientation;
   std::optional<LinkStats> linking;   ///< when the passes were linked (linking.hpp)
+  /// The simulated cut of the written program (`scallop plan`; none for `paths`).
+  std::optional<VerificationSummary> verification;
   /// The G-code program's motion and estimated cycle time (gcode.hpp's gcodeMotion), with
   /// the rates it assumed (units per minute).
   std::optional<GcodeMotion> motion;
