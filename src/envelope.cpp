@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <atomic>
+#include <exception>
 #include <numbers>
+#include <thread>
 
 #include <fmt/format.h>
 
@@ -145,8 +148,8 @@ Vec3 arcPoint(const ArcGeometry& arc, double t) {
 class Lifter {
  public:
   Lifter(const SurfaceDistance& distance, double radius, double eps, std::size_t maxCells,
-         EnvelopeReport& report)
-      : distance_(distance), radius_(radius), eps_(eps), maxCells_(maxCells), report_(report) {
+         std::size_t& proofs)
+      : distance_(distance), radius_(radius), eps_(eps), maxCells_(maxCells), proofs_(proofs) {
     double top = -kInfinity;
     for (const BezierPatch& patch : distance.surface().patches) {
       for (const Vec3& p : patch.control) top = std::max(top, p.z);
@@ -164,7 +167,7 @@ class Lifter {
     if (z >= top_) return true;
     const SegmentClearance test =
         distance_.segmentClearance({x, y, z}, {x, y, top_}, radius_ - 0.5 * eps_, maxCells_);
-    ++report_.proofs;
+    ++proofs_;
     if (test.verdict != Clearance::proven && std::isfinite(test.distance)) {
       seedPatch_ = test.patch, seedU_ = test.u, seedV_ = test.v, seeded_ = true;
     }
@@ -216,7 +219,7 @@ class Lifter {
   // Whether the straight move [a, b] is proven R - clearanceLoss clear.
   bool segmentClear(Vec3 a, Vec3 b, double clearanceLoss) {
     const SegmentClearance test = distance_.segmentClearance(a, b, radius_ - clearanceLoss, maxCells_);
-    ++report_.proofs;
+    ++proofs_;
     if (test.verdict != Clearance::proven && std::isfinite(test.distance)) {
       seedPatch_ = test.patch, seedU_ = test.u, seedV_ = test.v, seeded_ = true;
     }
@@ -228,7 +231,7 @@ class Lifter {
   double radius_;
   double eps_;
   std::size_t maxCells_;
-  EnvelopeReport& report_;
+  std::size_t& proofs_;
   double top_ = 0.0;
   struct Contact {
     double z = -kInfinity;
@@ -254,10 +257,9 @@ struct PassBuilder {
   std::vector<ToolMove> moves;
   std::vector<double> lifts;  // of each move's end
   std::size_t maxMoves = 0;
-  std::size_t* total = nullptr;
 
   void add(const ToolMove& move, double lift) {
-    if (++*total > maxMoves) {
+    if (moves.size() + 1 > maxMoves) {
       throw Error(fmt::format("lifting the path to the drop envelope: more than {} moves; the "
                               "depth tolerance is too fine for this path (raise it)",
                               maxMoves));
@@ -266,6 +268,111 @@ struct PassBuilder {
     lifts.push_back(lift);
   }
 };
+
+// One pass lifted (see the contract): its moves, per output vertex its lift (the start's
+// first; kInserted for a halving's midpoint), per input move the output moves so far, and
+// its counts.
+struct PassLift {
+  ToolPass pass;
+  std::vector<double> lifts;
+  std::vector<std::size_t> map;
+  std::size_t movesIn = 0, arcsKept = 0, arcsReplaced = 0, proofs = 0, unprovenMoves = 0;
+};
+
+PassLift liftPass(const SurfaceDistance& distance, const ToolPass& pass, std::size_t passIndex,
+                  double radius, double eps, const EnvelopeOptions& options) {
+  PassLift result;
+  if (!isFinite(pass.start)) {
+    throw Error(fmt::format("drop envelope: pass {}: the start is not finite", passIndex));
+  }
+  PassBuilder builder;
+  builder.maxMoves = options.maxMoves;
+  ToolPass& lifted = result.pass;
+  lifted.retractBefore = pass.retractBefore;
+  Lifter lifter(distance, radius, eps, options.maxCellsPerProof, result.proofs);
+  // The pass's first and last vertices are lifted cold (a Lifter of their own, with no
+  // contact carried over): a pass fed from the previous one's end then starts exactly where
+  // that end was lifted to, whichever thread lifted which.
+  const auto liftCold = [&](Vec3 p) {
+    Lifter cold(distance, radius, eps, options.maxCellsPerProof, result.proofs);
+    return cold.lift(p);
+  };
+  lifted.start = liftCold(pass.start);
+  const double startLift = lifted.start.z - pass.start.z;
+
+  // Straight moves from `from` (already lifted) to `to` (lifted): proven, or halved with
+  // the midpoint lifted, depth first so the moves come out in order.
+  auto refineLine = [&](auto&& self, Vec3 from, Vec3 to, double toLift, int halvings) -> void {
+    if (lifter.segmentClear(from, to, eps)) {
+      builder.add(ToolMove{MoveKind::line, to, {}, ArcPlane::xy, true}, toLift);
+      return;
+    }
+    if (halvings >= kEnvelopeMaxHalvings || !(norm(to - from) > 0.25 * eps)) {
+      ++result.unprovenMoves;
+      builder.add(ToolMove{MoveKind::line, to, {}, ArcPlane::xy, true}, toLift);
+      return;
+    }
+    const Vec3 middle = 0.5 * (from + to);
+    const Vec3 raised = lifter.lift(middle);
+    self(self, from, raised, kInserted, halvings + 1);
+    self(self, raised, to, toLift, halvings + 1);
+  };
+
+  Vec3 at = pass.start;       // the input position
+  Vec3 liftedAt = lifted.start;
+  for (std::size_t m = 0; m < pass.moves.size(); ++m) {
+    const ToolMove& move = pass.moves[m];
+    if (!isFinite(move.end) || (move.kind == MoveKind::arc && !isFinite(move.center))) {
+      throw Error(fmt::format("drop envelope: pass {}, move {}: not finite", passIndex, m));
+    }
+    ++result.movesIn;
+    const Vec3 end = m + 1 == pass.moves.size() ? liftCold(move.end) : lifter.lift(move.end);
+    const double endLift = end.z - move.end.z;
+    if (move.kind == MoveKind::line) {
+      refineLine(refineLine, liftedAt, end, endLift, 0);
+    } else {
+      const ArcGeometry arc = arcGeometry(at, move);
+      // Chords of sagitta <= eps / 4: k = ceil(|sweep| / (2 acos(1 - s / r))).
+      const double sagitta = 0.25 * eps;
+      const double step = 2.0 * std::acos(std::max(-1.0, 1.0 - sagitta / std::max(arc.radius, sagitta)));
+      const double pieces = std::ceil(std::abs(arc.sweep) / step);
+      if (!(pieces <= 1e6)) {
+        throw Error(fmt::format("drop envelope: pass {}, move {}: an arc of radius {} needs more "
+                                "than a million chords at depth tolerance {}", passIndex, m, arc.radius, eps));
+      }
+      const auto count = static_cast<std::size_t>(std::max(1.0, pieces));
+      bool keep = liftedAt == at && end == move.end;
+      // Each chord's sagitta, exactly: r (1 - cos(sweep / 2k)).
+      const double chordSagitta = arc.radius * (1.0 - std::cos(0.5 * std::abs(arc.sweep) / static_cast<double>(count)));
+      for (std::size_t i = 0; keep && i < count; ++i) {
+        const Vec3 a = i == 0 ? at : arcPoint(arc, static_cast<double>(i) / static_cast<double>(count));
+        const Vec3 b = i + 1 == count ? move.end : arcPoint(arc, static_cast<double>(i + 1) / static_cast<double>(count));
+        keep = lifter.segmentClear(a, b, eps - chordSagitta);
+      }
+      if (keep) {
+        ++result.arcsKept;
+        builder.add(move, 0.0);
+      } else {
+        ++result.arcsReplaced;
+        // Points of the arc a chord apart, each lifted, then refined as lines.
+        Vec3 from = liftedAt;
+        for (std::size_t i = 1; i <= count; ++i) {
+          const Vec3 onArc = i == count ? move.end : arcPoint(arc, static_cast<double>(i) / static_cast<double>(count));
+          const Vec3 raised = i == count ? end : lifter.lift(onArc);
+          refineLine(refineLine, from, raised, i == count ? endLift : raised.z - onArc.z, 0);
+          from = raised;
+        }
+      }
+    }
+    result.map.push_back(builder.moves.size());
+    at = move.end;
+    liftedAt = end;
+  }
+  lifted.moves = std::move(builder.moves);
+  result.lifts.push_back(startLift);
+  result.lifts.insert(result.lifts.end(), builder.lifts.begin(), builder.lifts.end());
+  return result;
+}
 
 }  // namespace
 
@@ -299,132 +406,81 @@ ToolPath liftToDropEnvelope(const SurfaceDistance& distance, const ToolPath& pat
   report = EnvelopeReport{};
   report.depthTolerance = eps;
   report.stretchThreshold = options.stretchThreshold > 0.0 ? options.stretchThreshold : 10.0 * eps;
-  Lifter lifter(distance, radius, eps, options.maxCellsPerProof, report);
+  // The passes are independent (each lifts its own vertices with its own Lifter; the first
+  // and last cold, see liftPass), so they are lifted on every core, and the result is the
+  // same for any number of threads.
+  std::vector<PassLift> lifts(path.passes.size());
+  std::vector<std::exception_ptr> errors(path.passes.size());
+  std::atomic<std::size_t> nextPass{0};
+  const auto work = [&] {
+    for (std::size_t i = nextPass++; i < path.passes.size(); i = nextPass++) {
+      try {
+        lifts[i] = liftPass(distance, path.passes[i], i, radius, eps, options);
+      } catch (...) {
+        errors[i] = std::current_exception();
+      }
+    }
+  };
+  const std::size_t threads = std::min<std::size_t>(
+      path.passes.size(), options.threads > 0 ? options.threads : std::max(1u, std::thread::hardware_concurrency()));
+  {
+    std::vector<std::jthread> pool;
+    for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(work);
+    work();
+  }
+  for (const std::exception_ptr& error : errors) {
+    if (error) std::rethrow_exception(error);  // the first pass's error, whatever the timing
+  }
+
   ToolPath out;
   out.units = path.units;
   out.toolRadius = radius;
-  std::size_t total = 0;
   if (moveMap) moveMap->assign(path.passes.size(), {});
-
+  std::size_t total = 0;
   for (std::size_t passIndex = 0; passIndex < path.passes.size(); ++passIndex) {
-    const ToolPass& pass = path.passes[passIndex];
-    if (!isFinite(pass.start)) {
-      throw Error(fmt::format("drop envelope: pass {}: the start is not finite", passIndex));
+    PassLift& lifted = lifts[passIndex];
+    total += lifted.pass.moves.size();
+    if (total > options.maxMoves) {
+      throw Error(fmt::format("lifting the path to the drop envelope: more than {} moves; the "
+                              "depth tolerance is too fine for this path (raise it)",
+                              options.maxMoves));
     }
-    PassBuilder builder;
-    builder.maxMoves = options.maxMoves;
-    builder.total = &total;
-    ToolPass lifted;
-    lifted.retractBefore = pass.retractBefore;
-    // A pass fed from the previous one's end starts where that end was lifted to.
-    const bool continued = !pass.retractBefore && passIndex > 0 &&
-                           !path.passes[passIndex - 1].moves.empty() &&
-                           path.passes[passIndex - 1].moves.back().end == pass.start &&
-                           !out.passes.back().moves.empty();
-    lifted.start = continued ? out.passes.back().moves.back().end : lifter.lift(pass.start);
-    const double startLift = lifted.start.z - pass.start.z;
-
-    // Straight moves from `from` (already lifted) to `to` (lifted): proven, or halved with
-    // the midpoint lifted, depth first so the moves come out in order.
-    auto refineLine = [&](auto&& self, Vec3 from, Vec3 to, double toLift, int halvings) -> void {
-      if (lifter.segmentClear(from, to, eps)) {
-        builder.add(ToolMove{MoveKind::line, to, {}, ArcPlane::xy, true}, toLift);
-        return;
-      }
-      if (halvings >= kEnvelopeMaxHalvings || !(norm(to - from) > 0.25 * eps)) {
-        ++report.unprovenMoves;
-        builder.add(ToolMove{MoveKind::line, to, {}, ArcPlane::xy, true}, toLift);
-        return;
-      }
-      const Vec3 middle = 0.5 * (from + to);
-      const Vec3 raised = lifter.lift(middle);
-      self(self, from, raised, kInserted, halvings + 1);
-      self(self, raised, to, toLift, halvings + 1);
-    };
-
-    Vec3 at = pass.start;       // the input position
-    Vec3 liftedAt = lifted.start;
-    for (std::size_t m = 0; m < pass.moves.size(); ++m) {
-      const ToolMove& move = pass.moves[m];
-      if (!isFinite(move.end) || (move.kind == MoveKind::arc && !isFinite(move.center))) {
-        throw Error(fmt::format("drop envelope: pass {}, move {}: not finite", passIndex, m));
-      }
-      ++report.movesIn;
-      const Vec3 end = lifter.lift(move.end);
-      const double endLift = end.z - move.end.z;
-      if (move.kind == MoveKind::line) {
-        refineLine(refineLine, liftedAt, end, endLift, 0);
-      } else {
-        const ArcGeometry arc = arcGeometry(at, move);
-        // Chords of sagitta <= eps / 4: k = ceil(|sweep| / (2 acos(1 - s / r))).
-        const double sagitta = 0.25 * eps;
-        const double step = 2.0 * std::acos(std::max(-1.0, 1.0 - sagitta / std::max(arc.radius, sagitta)));
-        const double pieces = std::ceil(std::abs(arc.sweep) / step);
-        if (!(pieces <= 1e6)) {
-          throw Error(fmt::format("drop envelope: pass {}, move {}: an arc of radius {} needs more "
-                                  "than a million chords at depth tolerance {}", passIndex, m, arc.radius, eps));
-        }
-        const auto count = static_cast<std::size_t>(std::max(1.0, pieces));
-        bool keep = liftedAt == at && end == move.end;
-        // Each chord's sagitta, exactly: r (1 - cos(sweep / 2k)).
-        const double chordSagitta = arc.radius * (1.0 - std::cos(0.5 * std::abs(arc.sweep) / static_cast<double>(count)));
-        for (std::size_t i = 0; keep && i < count; ++i) {
-          const Vec3 a = i == 0 ? at : arcPoint(arc, static_cast<double>(i) / static_cast<double>(count));
-          const Vec3 b = i + 1 == count ? move.end : arcPoint(arc, static_cast<double>(i + 1) / static_cast<double>(count));
-          keep = lifter.segmentClear(a, b, eps - chordSagitta);
-        }
-        if (keep) {
-          ++report.arcsKept;
-          builder.add(move, 0.0);
-        } else {
-          ++report.arcsReplaced;
-          // Points of the arc a chord apart, each lifted, then refined as lines.
-          Vec3 from = liftedAt;
-          for (std::size_t i = 1; i <= count; ++i) {
-            const Vec3 onArc = i == count ? move.end : arcPoint(arc, static_cast<double>(i) / static_cast<double>(count));
-            const Vec3 raised = i == count ? end : lifter.lift(onArc);
-            refineLine(refineLine, from, raised, i == count ? endLift : raised.z - onArc.z, 0);
-            from = raised;
-          }
-        }
-      }
-      if (moveMap) (*moveMap)[passIndex].push_back(builder.moves.size());
-      at = move.end;
-      liftedAt = end;
-    }
-    lifted.moves = std::move(builder.moves);
-    report.movesOut += lifted.moves.size();
+    report.movesIn += lifted.movesIn;
+    report.movesOut += lifted.pass.moves.size();
+    report.arcsKept += lifted.arcsKept;
+    report.arcsReplaced += lifted.arcsReplaced;
+    report.proofs += lifted.proofs;
+    report.unprovenMoves += lifted.unprovenMoves;
+    if (moveMap) (*moveMap)[passIndex] = lifted.map;
 
     // Lifted vertices and stretches.
     const double threshold = report.stretchThreshold;
-    std::vector<double> lifts;
-    lifts.push_back(startLift);
-    lifts.insert(lifts.end(), builder.lifts.begin(), builder.lifts.end());
+    std::vector<double>& vertexLifts = lifted.lifts;
     // An inserted vertex (a halving's midpoint) has no input point below it: the lift of a
     // chord's midpoint is its sag, not the surface's doing. It counts as lifted as much as the
     // lesser of the input vertices around it.
     {
       double before = 0.0;
-      std::vector<double> after(lifts.size(), 0.0);
+      std::vector<double> after(vertexLifts.size(), 0.0);
       double next = 0.0;
-      for (std::size_t k = lifts.size(); k-- > 0;) {
-        if (lifts[k] != kInserted) next = lifts[k];
+      for (std::size_t k = vertexLifts.size(); k-- > 0;) {
+        if (vertexLifts[k] != kInserted) next = vertexLifts[k];
         after[k] = next;
       }
-      for (std::size_t k = 0; k < lifts.size(); ++k) {
-        if (lifts[k] != kInserted) {
-          before = lifts[k];
+      for (std::size_t k = 0; k < vertexLifts.size(); ++k) {
+        if (vertexLifts[k] != kInserted) {
+          before = vertexLifts[k];
         } else {
-          lifts[k] = std::min(before, after[k]);
+          vertexLifts[k] = std::min(before, after[k]);
         }
       }
     }
-    auto vertex = [&](std::size_t i) { return i == 0 ? lifted.start : lifted.moves[i - 1].end; };
+    auto vertex = [&](std::size_t i) { return i == 0 ? lifted.pass.start : lifted.pass.moves[i - 1].end; };
     std::size_t i = 0;
-    while (i < lifts.size()) {
-      report.maxLift = std::max(report.maxLift, lifts[i]);
-      if (lifts[i] > eps) ++report.verticesLifted;
-      if (!(lifts[i] > threshold)) {
+    while (i < vertexLifts.size()) {
+      report.maxLift = std::max(report.maxLift, vertexLifts[i]);
+      if (vertexLifts[i] > eps) ++report.verticesLifted;
+      if (!(vertexLifts[i] > threshold)) {
         ++i;
         continue;
       }
@@ -432,19 +488,19 @@ ToolPath liftToDropEnvelope(const SurfaceDistance& distance, const ToolPath& pat
       stretch.pass = passIndex;
       stretch.from = vertex(i);
       std::size_t j = i;
-      while (j + 1 < lifts.size() && lifts[j + 1] > threshold) {
+      while (j + 1 < vertexLifts.size() && vertexLifts[j + 1] > threshold) {
         ++j;
         stretch.length += norm(vertex(j) - vertex(j - 1));
-        report.maxLift = std::max(report.maxLift, lifts[j]);
-        if (lifts[j] > eps) ++report.verticesLifted;
+        report.maxLift = std::max(report.maxLift, vertexLifts[j]);
+        if (vertexLifts[j] > eps) ++report.verticesLifted;
       }
-      for (std::size_t k = i; k <= j; ++k) stretch.maxLift = std::max(stretch.maxLift, lifts[k]);
+      for (std::size_t k = i; k <= j; ++k) stretch.maxLift = std::max(stretch.maxLift, vertexLifts[k]);
       stretch.to = vertex(j);
       report.liftedLength += stretch.length;
       report.stretches.push_back(stretch);
       i = j + 1;
     }
-    out.passes.push_back(std::move(lifted));
+    out.passes.push_back(std::move(lifted.pass));
   }
   return out;
 }

@@ -404,6 +404,42 @@ TEST(DropEnvelope, RasterOnSurfacesThatAreNotGraphs) {
   }
 }
 
+// The passes are lifted in parallel: the result is the same, bit for bit, for 1, 2 and 5
+// threads (raster: its linked passes start exactly where the previous one was lifted to).
+TEST(DropEnvelope, SameResultForAnyNumberOfThreads) {
+  const Surface s = exampleSurface("paper-2");
+  RasterOptions o;
+  o.bestAngle = true;
+  o.toolRadius = 0.25;
+  o.spacing = 0.2;
+  o.dropEnvelope = false;
+  const ToolPath input = rasterPaths(s, o).path;
+  const SurfaceDistance distance(s);
+  std::vector<ToolPath> outs;
+  for (const std::size_t threads : {1u, 2u, 5u}) {
+    EnvelopeOptions options;
+    options.threads = threads;
+    EnvelopeReport report;
+    outs.push_back(liftToDropEnvelope(distance, input, options, report));
+  }
+  for (std::size_t k = 1; k < outs.size(); ++k) {
+    ASSERT_EQ(outs[k].passes.size(), outs[0].passes.size());
+    for (std::size_t p = 0; p < outs[0].passes.size(); ++p) {
+      const ToolPass& a = outs[0].passes[p];
+      const ToolPass& b = outs[k].passes[p];
+      EXPECT_EQ(a.start, b.start) << p;
+      ASSERT_EQ(a.moves.size(), b.moves.size()) << p;
+      for (std::size_t m = 0; m < a.moves.size(); ++m) EXPECT_EQ(a.moves[m].end, b.moves[m].end) << p << " " << m;
+    }
+  }
+  // Continuity of the linked passes.
+  for (std::size_t p = 1; p < outs[0].passes.size(); ++p) {
+    if (!input.passes[p].retractBefore) {
+      EXPECT_EQ(outs[0].passes[p].start, outs[0].passes[p - 1].moves.back().end) << p;
+    }
+  }
+}
+
 // The options and the path are checked.
 TEST(DropEnvelope, RejectsBadInput) {
   const Surface s = exampleSurface("paper-1");

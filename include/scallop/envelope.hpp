@@ -49,6 +49,10 @@
 // Errors: scallop::Error for eps not positive and finite, a path whose units or radius do
 //         not match, non-finite positions, or more than maxMoves output moves (a tolerance
 //         too fine for the path: the message says so).
+// Threads: the passes are lifted in parallel (EnvelopeOptions::threads), each with its own
+//         state; a pass's first and last vertices are lifted without the state carried along
+//         the pass, so a pass fed from the previous one's end starts exactly where that end
+//         was lifted to. The output is the same for any number of threads.
 // Complexity: a proof costs tens of cells near the surface; a lifted vertex a Newton solve
 //         and one proof (a bisection of ~log2(height / eps) proofs where the local
 //         maximum is not the global one). Moves come out about sqrt(8 eps rho) long on a
@@ -76,6 +80,8 @@ struct EnvelopeOptions {
   std::size_t maxMoves = 5'000'000;
   /// Budget: cells per clearance proof (>= 1).
   std::size_t maxCellsPerProof = 100'000;
+  /// Threads lifting passes at once; 0: every core. The result is the same for any number.
+  std::size_t threads = 0;
 };
 
 /// A run of consecutive output vertices of one pass lifted by more than the threshold: an
