@@ -44,6 +44,7 @@ struct PathsOptions {
   std::string rapidRate;
   bool noLinking = false;
   bool oneWay = false;
+  bool constantSpacing = false;
 };
 
 void runPaths(const PathsOptions& options) {
@@ -65,6 +66,7 @@ void runPaths(const PathsOptions& options) {
   if (!options.angle.empty()) job.angleDeg = parseFinite(options.angle, "angle", "degrees");
   job.gougeCheck = !options.noGougeCheck;
   job.link = !options.noLinking;
+  job.constantSpacing = options.constantSpacing;
   job.linking.direction = options.oneWay ? PassDirection::keep : PassDirection::zigzag;
 
   const Surface surface = loadSurface(options.surface);
@@ -135,6 +137,9 @@ void addPathsCommand(CLI::App& app) {
       ->type_name("DEG");
   addDialectOption(*paths, options->dialect);
   addLinkingOptions(*paths, options->noLinking, options->oneWay, options->rapidRate);
+  paths->add_flag("--constant-spacing", options->constantSpacing,
+                  "with --scallop-height: the paper's constant plane spacing (flat-surface formula) "
+                  "instead of adaptive offsets that keep the estimated cusp <= H on curved parts");
   paths->add_option("--json", options->jsonPath, "write the report and the passes as JSON (- = standard output)")
       ->type_name("OUT");
   paths->add_option("--gcode", options->gcodePath, "write the G-code program")->type_name("OUT");

@@ -49,6 +49,7 @@ struct PlanOptions {
   std::string rapidRate;
   bool noLinking = false;
   bool oneWay = false;
+  bool constantSpacing = false;
   bool quiet = false;
 };
 
@@ -78,6 +79,7 @@ void runPlan(const PlanOptions& options) {
                             : parsePositive(options.scallopHeight, "scallop height", "a positive length");
   }
   job.link = !options.noLinking;
+  job.constantSpacing = options.constantSpacing;
   job.linking.direction = options.oneWay ? PassDirection::keep : PassDirection::zigzag;
   const double rapidRate = options.rapidRate.empty()
                                ? defaultRapidRate(surface.units)
@@ -155,6 +157,9 @@ void addPlanCommand(CLI::App& app) {
       ->type_name("D");
   addDialectOption(*plan, options->dialect);
   addLinkingOptions(*plan, options->noLinking, options->oneWay, options->rapidRate);
+  plan->add_flag("--constant-spacing", options->constantSpacing,
+                  "with --scallop-height: the paper's constant plane spacing (flat-surface formula) "
+                  "instead of adaptive offsets that keep the estimated cusp <= H on curved parts");
   plan->add_option("--out", options->out, "output folder (default scallop-out)")->type_name("DIR");
   plan->add_flag("--quiet", options->quiet, "no progress lines");
   plan->callback([options] { runPlan(*options); });
