@@ -28,10 +28,12 @@
 //         surface is l = Delta / sqrt(1 - (N . n)^2) = Delta / sin(angle(N, n)); the ball
 //         leaves a cusp of height h = R - sqrt(R^2 - l^2 / 4) between neighbouring passes
 //         (on a locally flat surface). The worst case is at the smallest angle alpha between
-//         N and +-n over the surface, so h <= H everywhere when
+//         N and +-n over the surface, so h <= H on flat parts when
 //         Delta = 2 sqrt(2 R H - H^2) sin(alpha)   (spacingForScallopHeight).
 //         This is why the optimal N* (largest alpha*) allows the widest planes for a given
-//         scallop height: the path is shortest.
+//         scallop height: the path is shortest. On curved parts the cusp differs (higher on
+//         convex ones): cusp.hpp estimates it from the curvature and chooses planeOffsets
+//         that keep it <= H.
 // Complexity: one planeSection per plane: O(planes * (cells + vertices)).
 
 #include <cstddef>

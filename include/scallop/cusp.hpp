@@ -55,7 +55,12 @@
 //         (subsampled); raster passes are placed by the scallop hull in their plane and
 //         lifted in 3D by the drop envelope (envelope.hpp), so their balls do not sit
 //         exactly at p + R n, and the final raster cusp differs from this in-plane model;
-//         contour passes lifted by the drop envelope (concave radius < R, creases) likewise.
+//         contour passes lifted by the drop envelope (concave radius < R, creases) likewise;
+//         a pass is a chord between exact offset points, and where the surface is concave
+//         along the pass the chord lies above the true offset curve, adding up to the
+//         chordal tolerance (the CLI traces sections to H / 20 for this); at an edge oblique
+//         to the passes the material between two passes' ends is higher than their cusp
+//         (an end effect the model does not see).
 //         The tests judge the contour cusp independently by the lower envelope of the swept
 //         balls over dense surface samples.
 // Adaptive offsets (adaptivePlaneOffsets): the surface's extent [s_lo, s_hi] of N . r is
