@@ -107,6 +107,37 @@ TEST(Cusp, BadArgumentsAreErrors) {
                scallop::Error);
 }
 
+// The strategies' explicit plane offsets: used as given (offset, k = index), checked.
+TEST(Cusp, PlaneOffsetsOption) {
+  const Surface s = scallop::exampleSurface("paper-1");
+  scallop::ContourOptions contour;
+  contour.normal = {0, 1, 0};
+  contour.toolRadius = 0.25;
+  contour.dropEnvelope = false;
+  contour.planeOffsets = {-5.0, 0.5, 0.75, 2.0};  // the first misses the surface
+  const scallop::ContourPaths paths = scallop::contourPaths(s, contour);
+  ASSERT_EQ(paths.sections.size(), 3u);
+  EXPECT_EQ(paths.sections[0].offset, 0.5);
+  EXPECT_EQ(paths.sections[0].k, 1);
+  EXPECT_EQ(paths.sections[2].offset, 2.0);
+  EXPECT_EQ(paths.sections[2].k, 3);
+  for (const auto& bad : {std::vector<double>{0.5, 0.5}, std::vector<double>{1.0, 0.5},
+                          std::vector<double>{0.5, std::nan("")}}) {
+    contour.planeOffsets = bad;
+    EXPECT_THROW(scallop::contourPaths(s, contour), scallop::Error);
+  }
+  scallop::RasterOptions raster;
+  raster.toolRadius = 0.25;
+  raster.dropEnvelope = false;
+  raster.planeOffsets = {0.5, 1.25};
+  const scallop::RasterPaths r = scallop::rasterPaths(s, raster);
+  ASSERT_EQ(r.sections.size(), 2u);
+  EXPECT_EQ(r.sections[1].offset, 1.25);
+  EXPECT_EQ(r.sections[1].k, 1);
+  raster.planeOffsets = {1.25, 0.5};
+  EXPECT_THROW(scallop::rasterPaths(s, raster), scallop::Error);
+}
+
 // Bernstein coefficients of the interpolant of f at Chebyshev nodes on [0, 1] (degree m),
 // by Gaussian elimination on the collocation matrix.
 std::vector<double> bernsteinInterpolant(int m, const std::function<double(double)>& f) {
