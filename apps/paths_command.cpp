@@ -45,6 +45,7 @@ struct PathsOptions {
   bool noLinking = false;
   bool noDropEnvelope = false;
   bool oneWay = false;
+  bool constantSpacing = false;
 };
 
 void runPaths(const PathsOptions& options) {
@@ -67,6 +68,7 @@ void runPaths(const PathsOptions& options) {
   job.gougeCheck = !options.noGougeCheck;
   job.link = !options.noLinking;
   job.dropEnvelope = !options.noDropEnvelope;
+  job.constantSpacing = options.constantSpacing;
   job.linking.direction = options.oneWay ? PassDirection::keep : PassDirection::zigzag;
 
   const Surface surface = loadSurface(options.surface);
@@ -141,6 +143,9 @@ void addPathsCommand(CLI::App& app) {
                  "keep the strategy's own centres (contour: r + R n; raster: the in-plane scallop hull) "
                  "instead of lifting them to the proven gouge-free drop envelope; they cut into the "
                  "surface where the report's gouge check says");
+  paths->add_flag("--constant-spacing", options->constantSpacing,
+                  "with --scallop-height: the paper's constant plane spacing (flat-surface formula) "
+                  "instead of adaptive offsets that keep the estimated cusp <= H on curved parts");
   paths->add_option("--json", options->jsonPath, "write the report and the passes as JSON (- = standard output)")
       ->type_name("OUT");
   paths->add_option("--gcode", options->gcodePath, "write the G-code program")->type_name("OUT");

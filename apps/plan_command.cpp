@@ -54,6 +54,7 @@ struct PlanOptions {
   bool noLinking = false;
   bool noDropEnvelope = false;
   bool oneWay = false;
+  bool constantSpacing = false;
   bool quiet = false;
 };
 
@@ -84,6 +85,7 @@ void runPlan(const PlanOptions& options) {
   }
   job.link = !options.noLinking;
   job.dropEnvelope = !options.noDropEnvelope;
+  job.constantSpacing = options.constantSpacing;
   job.linking.direction = options.oneWay ? PassDirection::keep : PassDirection::zigzag;
   const double rapidRate = options.rapidRate.empty()
                                ? defaultRapidRate(surface.units)
@@ -192,6 +194,9 @@ void addPlanCommand(CLI::App& app) {
                  "keep the strategy's own centres (contour: r + R n; raster: the in-plane scallop hull) "
                  "instead of lifting them to the proven gouge-free drop envelope; they cut into the "
                  "surface where the report's gouge check says");
+  plan->add_flag("--constant-spacing", options->constantSpacing,
+                  "with --scallop-height: the paper's constant plane spacing (flat-surface formula) "
+                  "instead of adaptive offsets that keep the estimated cusp <= H on curved parts");
   plan->add_option("--out", options->out, "output folder (default scallop-out)")->type_name("DIR");
   plan->add_flag("--quiet", options->quiet, "no progress lines");
   plan->callback([options] { runPlan(*options); });

@@ -11,6 +11,7 @@
 
 #include "arguments.hpp"
 #include "scallop/contour.hpp"
+#include "scallop/cusp.hpp"
 #include "scallop/error.hpp"
 #include "scallop/gouge.hpp"
 #include "scallop/raster.hpp"
@@ -39,6 +40,60 @@ void checkGouge(const Surface& surface, const JobOptions& options, JobResult& re
   say(progress, fmt::format("checking the ball against the whole surface every {:.6g}", spacing));
   result.report.gouge = gougeCheck(surface, result.path, spacing);
   result.report.gougeSampleSpacing = spacing;
+}
+
+// The scallop height on the curved surface (cusp.hpp): with H, the sections are traced to
+// H / 20 (a pass is a chord between exact offset points; where the surface is concave along
+// the pass the chord lies above the true offset curve and leaves up to the chordal tolerance
+// of extra material) and, unless --constant-spacing, the planes are adaptivePlaneOffsets'.
+struct ScallopPlanes {
+  std::vector<double> offsets;  ///< empty: k Delta
+  double chordalTolerance = 0.0;  ///< 0: the strategy's default
+  std::size_t floorSteps = 0;
+};
+
+ScallopPlanes scallopPlanes(const Surface& surface, const JobOptions& options, const Vec3& normal,
+                            const Progress& progress) {
+  ScallopPlanes out;
+  if (!options.scallopHeight || options.constantSpacing) return out;
+  out.chordalTolerance =
+      std::min(1e-4 * std::max(surfaceScale(surface), 1e-300), *options.scallopHeight / 20.0);
+  CuspOptions cusp;
+  cusp.toolRadius = options.toolRadius;
+  cusp.scallopHeight = *options.scallopHeight;
+  cusp.chordalTolerance = out.chordalTolerance;
+  say(progress, "choosing plane offsets that keep the cusp below the scallop height on the curved surface");
+  AdaptiveOffsets adaptive = adaptivePlaneOffsets(surface, normal, cusp);
+  out.offsets = std::move(adaptive.offsets);
+  out.floorSteps = adaptive.floorSteps;
+  return out;
+}
+
+ScallopReport scallopReport(const Surface& surface, const JobOptions& options, const Vec3& normal,
+                            double flatSpacing, const ScallopPlanes& planes,
+                            const std::vector<PlaneContacts>& used) {
+  ScallopReport report;
+  report.adaptive = !planes.offsets.empty();
+  report.flatSpacing = flatSpacing;
+  const auto [lo, hi] = sampledExtent(surface, normal);
+  report.flatPlanes =
+      static_cast<std::size_t>(std::max(0.0, std::floor(hi / flatSpacing) - std::ceil(lo / flatSpacing) + 1.0));
+  report.planes = used.size();
+  report.minSpacing = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k + 1 < used.size(); ++k) {
+    const double gap = used[k + 1].offset - used[k].offset;
+    report.minSpacing = std::min(report.minSpacing, gap);
+    report.maxSpacing = std::max(report.maxSpacing, gap);
+  }
+  if (used.size() < 2) report.minSpacing = 0.0;
+  report.floorSteps = planes.floorSteps;
+  report.chordalTolerance = planes.chordalTolerance > 0.0
+                                ? planes.chordalTolerance
+                                : 1e-4 * std::max(surfaceScale(surface), 1e-300);
+  CuspOptions cusp;
+  cusp.toolRadius = options.toolRadius;
+  report.cusp = cuspStatistics(surface, normal, used, cusp);
+  return report;
 }
 
 void runContour(const Surface& surface, const JobOptions& options, JobResult& result,
@@ -81,8 +136,18 @@ void runContour(const Surface& surface, const JobOptions& options, JobResult& re
   contour.spacing = options.spacing ? *options.spacing
                                     : spacingForScallopHeight(options.toolRadius,
                                                               *options.scallopHeight, alpha);
-  say(progress, fmt::format("cutting the surface with planes {:.6g} apart", contour.spacing));
+  const ScallopPlanes planes = scallopPlanes(surface, options, normal, progress);
+  contour.planeOffsets = planes.offsets;
+  contour.chordalTolerance = planes.chordalTolerance;
+  say(progress, planes.offsets.empty()
+                    ? fmt::format("cutting the surface with planes {:.6g} apart", contour.spacing)
+                    : fmt::format("cutting the surface with {} planes", planes.offsets.size()));
   ContourPaths paths = contourPaths(surface, contour);
+  if (options.scallopHeight) {
+    std::vector<PlaneContacts> used;
+    for (const ContourSection& section : paths.sections) used.push_back({section.offset, &section.section});
+    result.report.scallop = scallopReport(surface, options, paths.normal, contour.spacing, planes, used);
+  }
   result.report.spacing = paths.spacing;
   result.report.planeNormal = paths.normal;
   result.report.alphaRad = alpha;
@@ -100,16 +165,33 @@ void runRaster(const Surface& surface, const JobOptions& options, JobResult& res
   raster.toolRadius = options.toolRadius;
   if (options.scallopHeight) raster.stretchThreshold = *options.scallopHeight;
   raster.dropEnvelope = options.dropEnvelope;
+  const bool adaptive = options.scallopHeight && !options.constantSpacing;
   if (options.angleDeg) {
     raster.angleRad = *options.angleDeg * kDeg;
+  } else if (adaptive) {
+    // The planes' normal is needed before the paths: the same search rasterPaths would run.
+    say(progress, "searching the feed direction with the widest step-over");
+    raster.angleRad = bestRasterAngle(surface);
   } else {
     raster.bestAngle = true;
     say(progress, "searching the feed direction with the widest step-over");
   }
   if (options.spacing) raster.spacing = *options.spacing;
   if (options.scallopHeight) raster.scallopHeight = *options.scallopHeight;
+  ScallopPlanes planes;
+  if (adaptive) {
+    const Vec3 e{-std::sin(raster.angleRad), std::cos(raster.angleRad), 0.0};
+    planes = scallopPlanes(surface, options, e, progress);
+    raster.planeOffsets = planes.offsets;
+    raster.chordalTolerance = planes.chordalTolerance;
+  }
   say(progress, "cutting the surface with vertical planes; scallop hull of each section");
   RasterPaths paths = rasterPaths(surface, raster);
+  if (options.scallopHeight) {
+    std::vector<PlaneContacts> used;
+    for (const RasterSection& section : paths.sections) used.push_back({section.offset, &section.section});
+    result.report.scallop = scallopReport(surface, options, paths.planeNormal, paths.spacing, planes, used);
+  }
   result.report.spacing = paths.spacing;
   result.report.planeNormal = paths.planeNormal;
   result.report.alphaRad = paths.alphaRad;

@@ -21,7 +21,10 @@ struct JobOptions {
   std::string strategy = "contour";     ///< "contour" or "raster"
   double toolRadius = 0.0;              ///< R > 0
   std::optional<double> spacing;        ///< Delta, or
-  std::optional<double> scallopHeight;  ///< H (0 < H < R): Delta from H and alpha
+  std::optional<double> scallopHeight;  ///< H (0 < H < R): planes from H (cusp.hpp)
+  /// With H: the paper's constant Delta from H and alpha (flat-surface formula) instead of
+  /// the adaptive offsets that keep the estimated cusp <= H on the curved surface.
+  bool constantSpacing = false;
   std::optional<Vec3> normal;           ///< contour: N; none = the optimal N* (orient)
   std::optional<double> angleDeg;       ///< raster: feed angle; none = the best angle
   bool gougeCheck = true;               ///< measure the ball's interference (gouge.hpp)

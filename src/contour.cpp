@@ -36,6 +36,19 @@ Vec3 upwardNormal(const Surface& surface, std::size_t patch, double u, double v)
   return n.z < 0.0 ? -n : n;
 }
 
+void validatePlaneOffsets(const std::vector<double>& offsets, const char* what) {
+  if (offsets.size() > static_cast<std::size_t>(kMaxPlanes))
+    throw Error(fmt::format("{}: {} planes; more than 100,000 is not a tool path", what,
+                            offsets.size()));
+  for (std::size_t i = 0; i < offsets.size(); ++i) {
+    if (!std::isfinite(offsets[i]))
+      throw Error(fmt::format("{}: offset {} is not finite ({})", what, i, offsets[i]));
+    if (i > 0 && !(offsets[i] > offsets[i - 1]))
+      throw Error(fmt::format("{}: offsets must increase strictly, got {} then {}", what,
+                              offsets[i - 1], offsets[i]));
+  }
+}
+
 double spacingForScallopHeight(double toolRadius, double scallopHeight, double alphaRad) {
   requirePositive("the tool radius", toolRadius);
   requirePositive("the scallop height", scallopHeight);
@@ -121,7 +134,9 @@ ContourPaths contourPaths(const Surface& surface, const ContourOptions& options)
   if (!std::isfinite(length) || length == 0.0)
     throw Error(fmt::format("the plane normal ({}, {}, {}) must be finite and non-zero",
                             options.normal.x, options.normal.y, options.normal.z));
-  requirePositive("the plane spacing", options.spacing);
+  validatePlaneOffsets(options.planeOffsets, "the plane offsets");
+  const bool explicitOffsets = !options.planeOffsets.empty();
+  if (!explicitOffsets) requirePositive("the plane spacing", options.spacing);
   requirePositive("the tool radius", options.toolRadius);
   if (!(options.depthTolerance >= 0.0) || !std::isfinite(options.depthTolerance))
     throw Error(fmt::format("the depth tolerance must be a finite number >= 0, got {}", options.depthTolerance));
@@ -135,10 +150,14 @@ ContourPaths contourPaths(const Surface& surface, const ContourOptions& options)
   out.spacing = options.spacing;
   out.path.units = surface.units;
   out.path.toolRadius = options.toolRadius;
-  const PlaneRange range = planeRange(surface, out.normal, options.spacing, "the plane spacing");
+  const PlaneRange range =
+      explicitOffsets ? PlaneRange{options.planeOffsets.front(), options.planeOffsets.back(), 0.0,
+                                   static_cast<double>(options.planeOffsets.size() - 1)}
+                      : planeRange(surface, out.normal, options.spacing, "the plane spacing");
   for (double kk = range.first; kk <= range.last; kk += 1.0) {
     const long long k = static_cast<long long>(kk);
-    const double offset = kk * options.spacing;
+    const double offset = explicitOffsets ? options.planeOffsets[static_cast<std::size_t>(k)]
+                                          : kk * options.spacing;
     PlaneSection section = planeSection(surface, out.normal, offset, tolerance);
     out.stats.touchPoints += section.touchPoints.size();
     if (section.curves.empty()) continue;

@@ -129,6 +129,29 @@ std::string pathsToJson(const PathsReport& report, const ToolPath& path) {
   if (report.linkLength) stats["link_length"] = *report.linkLength;
   if (report.unclearedEnds) stats["uncleared_ends"] = *report.unclearedEnds;
   document["stats"] = stats;
+  if (report.scallop) {
+    const ScallopReport& r = *report.scallop;
+    // An infinite cusp (balls that do not meet) has no JSON number: null.
+    const auto number = [](double x) { return std::isfinite(x) ? Json(x) : Json(nullptr); };
+    Json scallop;
+    scallop["spacing_mode"] = r.adaptive ? "adaptive" : "constant";
+    scallop["flat_spacing"] = r.flatSpacing;
+    scallop["flat_planes"] = r.flatPlanes;
+    scallop["planes"] = r.planes;
+    scallop["min_spacing"] = r.minSpacing;
+    scallop["max_spacing"] = r.maxSpacing;
+    scallop["floor_steps"] = r.floorSteps;
+    scallop["chordal_tolerance"] = r.chordalTolerance;
+    Json cusp;
+    cusp["max"] = number(r.cusp.max);
+    cusp["p99"] = number(r.cusp.p99);
+    cusp["mean"] = number(r.cusp.mean);
+    cusp["samples"] = r.cusp.samples;
+    cusp["pairs"] = r.cusp.pairs;
+    cusp["too_tight"] = r.cusp.tooTight;
+    scallop["cusp_estimate"] = cusp;
+    document["scallop"] = scallop;
+  }
   if (report.envelope) {
     const EnvelopeReport& e = *report.envelope;
     Json envelope;

@@ -545,7 +545,11 @@ RasterPaths rasterPaths(const Surface& surface, const RasterOptions& options) {
   if (!options.bestAngle && !std::isfinite(options.angleRad))
     throw Error(fmt::format("the feed angle must be a finite number of radians, got {}",
                             options.angleRad));
-  if (options.scallopHeight != 0.0) {
+  validatePlaneOffsets(options.planeOffsets, "the plane offsets");
+  const bool explicitOffsets = !options.planeOffsets.empty();
+  if (explicitOffsets && options.spacing == 0.0 && options.scallopHeight == 0.0) {
+    // The offsets alone: no spacing to report.
+  } else if (options.scallopHeight != 0.0) {
     if (options.spacing != 0.0)
       throw Error(fmt::format("give the step-over ({}) or the scallop height ({}), not both",
                               options.spacing, options.scallopHeight));
@@ -570,13 +574,17 @@ RasterPaths rasterPaths(const Surface& surface, const RasterOptions& options) {
   out.feedDirection = frame.d;
   out.planeNormal = frame.e;
   out.alphaRad = minimumAngleBound(surface, frame.e);
-  out.spacing = options.spacing > 0.0
-                    ? options.spacing
-                    : spacingForScallopHeight(radius, options.scallopHeight, out.alphaRad);
+  out.spacing = options.spacing > 0.0 ? options.spacing
+                : options.scallopHeight > 0.0
+                    ? spacingForScallopHeight(radius, options.scallopHeight, out.alphaRad)
+                    : 0.0;
   out.path.units = surface.units;
   out.path.toolRadius = radius;
 
-  const PlaneRange range = planeRange(surface, frame.e, out.spacing, "the step-over");
+  const PlaneRange range =
+      explicitOffsets ? PlaneRange{options.planeOffsets.front(), options.planeOffsets.back(), 0.0,
+                                   static_cast<double>(options.planeOffsets.size() - 1)}
+                      : planeRange(surface, frame.e, out.spacing, "the step-over");
 
   const HeightBound heights(surface, tolerance, 1e-12 * scale);
   // The ways off (see the contract): limits `slack` above the pass end's depth, proven with
@@ -590,7 +598,8 @@ RasterPaths rasterPaths(const Surface& surface, const RasterOptions& options) {
   };
   const auto line = [](Vec3 end) { return ToolMove{MoveKind::line, end, {}, ArcPlane::xy, true}; };
   for (double kk = range.first; kk <= range.last; kk += 1.0) {
-    const double w = kk * out.spacing;
+    const double w =
+        explicitOffsets ? options.planeOffsets[static_cast<std::size_t>(kk)] : kk * out.spacing;
     PlaneSection section = planeSection(surface, frame.e, w, tolerance);
     out.stats.touchPoints += section.touchPoints.size();
     RasterSection plane;

@@ -278,3 +278,44 @@ TEST_F(PathsCli, PlanFailsCleanlyAndLeavesNoFolder) {
 }
 
 }  // namespace
+
+// With --scallop-height the planes are adaptive by default (cusp.hpp) and the report gives the
+// estimated cusp distribution beside the paper's flat-surface spacing; --constant-spacing
+// keeps the paper's Delta, whose estimated cusp exceeds H on paper-2's convex parts.
+TEST_F(PathsCli, ScallopReportAdaptiveAndConstant) {
+  const std::string common = "paths --example paper-2 --tool-radius 0.25 --scallop-height 0.001 "
+                             "--no-gouge-check --no-linking";
+  ASSERT_EQ(run(common + " --json adaptive.json").exitCode, 0);
+  ASSERT_EQ(run(common + " --constant-spacing --json constant.json").exitCode, 0);
+  const auto adaptive = nlohmann::json::parse(readFile(workDir_ / "adaptive.json"));
+  const auto constant = nlohmann::json::parse(readFile(workDir_ / "constant.json"));
+  const auto& a = adaptive["scallop"];
+  const auto& c = constant["scallop"];
+  EXPECT_EQ(a["spacing_mode"], "adaptive");
+  EXPECT_EQ(c["spacing_mode"], "constant");
+  // The paper's spacing is the same both ways, and it is the report's "spacing".
+  const double alpha = adaptive["alpha_deg"].get<double>() * M_PI / 180.0;
+  const double flat = 2 * std::sqrt(2 * 0.25 * 0.001 - 1e-6) * std::sin(alpha);
+  EXPECT_NEAR(a["flat_spacing"].get<double>(), flat, 1e-12);
+  EXPECT_EQ(a["flat_spacing"], c["flat_spacing"]);
+  EXPECT_EQ(adaptive["spacing"], a["flat_spacing"]);
+  // Constant: every gap is Delta; adaptive: they vary, and fewer planes cover paper-2.
+  EXPECT_NEAR(c["min_spacing"].get<double>(), flat, 1e-12);
+  EXPECT_NEAR(c["max_spacing"].get<double>(), flat, 1e-12);
+  EXPECT_LT(a["min_spacing"].get<double>(), a["max_spacing"].get<double>());
+  EXPECT_EQ(a["planes"], adaptive["stats"]["planes"]);
+  EXPECT_EQ(c["planes"], constant["stats"]["planes"]);
+  EXPECT_LT(a["planes"].get<int>(), c["planes"].get<int>());
+  // The estimate: <= H adaptive, above H for the flat-surface formula.
+  const auto& ac = a["cusp_estimate"];
+  const auto& cc = c["cusp_estimate"];
+  EXPECT_LE(ac["max"].get<double>(), 0.001);
+  EXPECT_GT(cc["max"].get<double>(), 0.001);
+  EXPECT_LE(ac["mean"].get<double>(), ac["p99"].get<double>());
+  EXPECT_LE(ac["p99"].get<double>(), ac["max"].get<double>());
+  EXPECT_GT(ac["samples"].get<int>(), 1000);
+  EXPECT_EQ(ac["pairs"].get<int>() + 1, a["planes"].get<int>());
+  // A shorter path for the same (estimated) finish.
+  EXPECT_LT(adaptive["stats"]["centre_length"].get<double>(),
+            constant["stats"]["centre_length"].get<double>());
+}

@@ -9,6 +9,8 @@
 // Input:  a valid surface (surface.hpp) to be cut from above (z up); a plane normal N
 //         (finite, non-zero; normalised); a spacing Delta > 0 between planes; a ball radius
 //         R > 0; a chordal tolerance (surface units) for the traced sections.
+//         Or an explicit increasing list of plane offsets (ContourOptions::planeOffsets,
+//         e.g. cusp.hpp's adaptive spacing), used instead of k Delta.
 // Output: every plane N . r = k Delta that cuts the surface (k from the control points'
 //         extent, so no plane is missed), its section (section.hpp), and one tool pass per
 //         section curve through the centres r + R n at the curve's vertices (n the unit
@@ -26,10 +28,12 @@
 //         surface is l = Delta / sqrt(1 - (N . n)^2) = Delta / sin(angle(N, n)); the ball
 //         leaves a cusp of height h = R - sqrt(R^2 - l^2 / 4) between neighbouring passes
 //         (on a locally flat surface). The worst case is at the smallest angle alpha between
-//         N and +-n over the surface, so h <= H everywhere when
+//         N and +-n over the surface, so h <= H on flat parts when
 //         Delta = 2 sqrt(2 R H - H^2) sin(alpha)   (spacingForScallopHeight).
 //         This is why the optimal N* (largest alpha*) allows the widest planes for a given
-//         scallop height: the path is shortest.
+//         scallop height: the path is shortest. On curved parts the cusp differs (higher on
+//         convex ones): cusp.hpp estimates it from the curvature and chooses planeOffsets
+//         that keep it <= H.
 // Complexity: one planeSection per plane: O(planes * (cells + vertices)).
 
 #include <cstddef>
@@ -57,6 +61,10 @@ struct ContourOptions {
   double depthTolerance = 0.0;  /// Lifts above this are reported as stretches the ball cannot follow (>= 0); 0 means
   /// the envelope's default (10 eps). The CLI passes the scallop height.
   double stretchThreshold = 0.0;
+  /// Explicit plane offsets (strictly increasing, finite, at most kMaxPlanes), used instead
+  /// of k Delta when non-empty: the planes N . r = planeOffsets[k] (cusp.hpp's
+  /// adaptivePlaneOffsets). `spacing` is then only reported (it may be 0).
+  std::vector<double> planeOffsets;
 };
 
 struct PathStats {
@@ -68,8 +76,8 @@ struct PathStats {
 };
 
 struct ContourSection {
-  double offset = 0.0;  ///< k Delta: the plane N . r = offset (N unit)
-  long long k = 0;
+  double offset = 0.0;  ///< k Delta (or planeOffsets[k]): the plane N . r = offset (N unit)
+  long long k = 0;      ///< k, or the index into planeOffsets
   PlaneSection section;
 };
 
@@ -102,6 +110,10 @@ struct PlaneRange {
 };
 PlaneRange planeRange(const Surface& surface, const Vec3& unitNormal, double spacing,
                       const char* what);
+
+/// Throws scallop::Error unless `offsets` is empty or strictly increasing, finite and at most
+/// kMaxPlanes long (`what` names the option).
+void validatePlaneOffsets(const std::vector<double>& offsets, const char* what);
 
 /// Delta = 2 sqrt(2 R H - H^2) sin(alpha): the plane spacing that keeps the scallop height
 /// below H where the planes meet the surface at angle >= alpha (radians) to its normal.

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "scallop/contour.hpp"
+#include "scallop/cusp.hpp"
 #include "scallop/envelope.hpp"
 #include "scallop/gcode.hpp"
 #include "scallop/gouge.hpp"
@@ -55,6 +56,21 @@ struct VerificationSummary {
   double seconds = 0.0;
 };
 
+/// The scallop height on the curved surface (cusp.hpp), when the spacing came from H: the
+/// plane offsets used (adaptive, or the paper's constant Delta) beside the paper's flat-surface
+/// spacing, and the distribution of the estimated cusp heights between neighbouring passes.
+struct ScallopReport {
+  bool adaptive = false;        ///< offsets from adaptivePlaneOffsets (else k Delta_flat)
+  double flatSpacing = 0.0;     ///< the paper's Delta = 2 sqrt(2RH - H^2) sin(alpha)
+  std::size_t flatPlanes = 0;   ///< planes k Delta_flat within the surface's sampled extent
+  std::size_t planes = 0;       ///< planes used that cut the surface
+  double minSpacing = 0.0;      ///< least and largest gap between neighbouring planes used
+  double maxSpacing = 0.0;
+  std::size_t floorSteps = 0;   ///< adaptive steps that fell to the floor (cusp.hpp)
+  double chordalTolerance = 0.0;  ///< the sections' (and so the passes' chords') tolerance
+  CuspStatistics cusp;          ///< estimated cusp heights (an estimate: see cusp.hpp)
+};
+
 struct PathsReport {
   std::string strategy;            ///< "contour" or "raster"
   std::string source;              ///< the surface's file or example name
@@ -70,6 +86,7 @@ struct PathsReport {
   std::optional<double> linkLength;
   std::optional<std::size_t> unclearedEnds;
   PathStats stats;
+  std::optional<ScallopReport> scallop;  ///< with a scallop height H (cusp.hpp)
   /// The drop envelope's lifting (envelope.hpp), when the strategy lifted its passes.
   std::optional<EnvelopeReport> envelope;
   std::optional<GougeReport> gouge;  ///< the ball against the whole surface, sampled

@@ -18,7 +18,8 @@
 //         plane the coordinates (s, z) = (d . r, z): a point is P(s, z) = s d + w e + z z^.
 //         When |sin a| < 1e-12 (|cos a| < 1e-12) d and e are snapped to exact +-x, +-y
 //         (+-y, +-x), so that arcs lie exactly in their principal plane.
-// Planes: e . r = w = k Delta for every integer k with w in the control points' range of
+// Planes: e . r = w = planeOffsets[k] when that list is given (cusp.hpp's adaptive spacing);
+//         otherwise e . r = w = k Delta for every integer k with w in the control points' range of
 //         e . r (the surface lies in their convex hull, so no plane that cuts is missed),
 //         in increasing k. A plane whose section has no curve of two or more points
 //         (it misses the surface, or only touches it) is skipped.
@@ -152,6 +153,11 @@ struct RasterOptions {
   double depthTolerance = 0.0;  /// Lifts above this are reported as stretches the ball cannot follow (>= 0); 0 means
   /// the envelope's default (10 eps). The CLI passes the scallop height.
   double stretchThreshold = 0.0;
+  /// Explicit plane offsets w (strictly increasing, finite, at most kMaxPlanes), used instead
+  /// of k Delta when non-empty: the planes e . r = planeOffsets[k] (cusp.hpp's
+  /// adaptivePlaneOffsets with N = e). Delta (spacing, or from scallopHeight) is then only
+  /// reported; spacing and scallopHeight may both be 0.
+  std::vector<double> planeOffsets;
 };
 
 /// One chain of a plane: what the scallop hull is computed from.
@@ -163,8 +169,8 @@ struct RasterChain {
 };
 
 struct RasterSection {
-  double offset = 0.0;  ///< w = k Delta: the plane e . r = w
-  long long k = 0;
+  double offset = 0.0;  ///< w = k Delta (or planeOffsets[k]): the plane e . r = w
+  long long k = 0;      ///< k, or the index into planeOffsets
   PlaneSection section;             ///< planeSection(surface, e, w, chordal tolerance)
   std::vector<RasterChain> chains;  ///< in increasing s
   bool reversed = false;            ///< its passes run toward decreasing s (zigzag)
