@@ -9,6 +9,7 @@
 //   stereographic.svg   the stereographic plane with the medial axis and the optimal circle
 // Everything is computed first; the folder is written all or nothing.
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -114,7 +115,8 @@ void runPlan(const PlanOptions& options) {
   const std::string program = gcodeProgram(result.path, gcodeOptions);
   // The program as written, read back and cut in simulation (scallop verify): the finishing
   // stock is the surface raised by half the links' clearance (what they assume roughing
-  // left), the scallop height the one asked (or the flat-surface one of the spacing given).
+  // left; at least 2 H, so scallops up to 2 H show), the scallop height the one asked (or the
+  // flat-surface one of the spacing given).
   progress("simulating the cut of the program (scallop verify)");
   SimulationOptions simulation;
   simulation.toolRadius = job.toolRadius;
@@ -122,7 +124,8 @@ void runPlan(const PlanOptions& options) {
                                  ? *job.scallopHeight
                                  : job.toolRadius - std::sqrt(job.toolRadius * job.toolRadius -
                                                               0.25 * report.spacing * report.spacing);
-  simulation.stockAllowance = report.linking ? 0.5 * report.linking->clearance : (inch ? 0.01 : 0.25);
+  simulation.stockAllowance = std::max(report.linking ? 0.5 * report.linking->clearance : (inch ? 0.01 : 0.25),
+                                       2.0 * simulation.scallopHeight);
   const SimulationReport simulated =
       verifyProgram(surface, parseGcodeProgram(program, programName), simulation);
   report.verification = VerificationSummary{simulated.design.spacing, simulated.heightErrorBound,

@@ -250,7 +250,15 @@ JobResult runToolpathJob(const Surface& surface, const std::string& source,
   if (options.link) {
     say(progress, "ordering and linking the passes");
     try {
-      LinkedPath linked = linkToolPath(surface, result.path, options.linking);
+      // The links' margin and their plunges at feed must exceed the stock left above the
+      // surface: the cusps, up to the scallop height H (more at the boundary), so at least 4 H.
+      LinkOptions linking = options.linking;
+      const double standard = surface.units == Units::inch ? 0.02 : 0.5;
+      if (linking.clearance == 0.0 && options.scallopHeight)
+        linking.clearance = std::max(standard, 4.0 * *options.scallopHeight);
+      if (linking.plunge == 0.0 && options.scallopHeight)
+        linking.plunge = std::max(standard, 4.0 * *options.scallopHeight);
+      LinkedPath linked = linkToolPath(surface, result.path, linking);
       result.path = std::move(linked.path);
       result.report.linking = linked.stats;
     } catch (const Error& error) {
