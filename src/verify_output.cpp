@@ -127,7 +127,10 @@ std::string verifySvg(const SimulationReport& r, const VerifySources& sources) {
   // Gouges on a logarithmic scale from the tolerance (or 1e-9 of the tool radius) to the
   // deepest: thousandths and tenths both show.
   const double floorGouge = std::max(r.gougeTolerance, 1e-9 * r.toolRadius);
-  const double gougeSpan = std::max(std::log(std::max(r.maxGouge, floorGouge) / floorGouge), 1e-300);
+  // Without a gouge beyond the tolerance the bar still spans a decade, so that its labels
+  // read as a scale (no block takes its colours then).
+  const double gougeScaleTop = std::max(r.maxGouge, 10.0 * floorGouge);
+  const double gougeSpan = std::log(gougeScaleTop / floorGouge);
   std::vector<int> colour(bx * by, kNoSurfaceIndex);
   for (std::size_t b = 0; b < by; ++b) {
     for (std::size_t a = 0; a < bx; ++a) {
@@ -251,7 +254,7 @@ std::string verifySvg(const SimulationReport& r, const VerifySources& sources) {
   out += fmt::format("<text x=\"{}\" y=\"{}\">{}</text>\n", px(barX + 26.0), px(gougeTop + 5 * step + 4.0),
                      lengthLabel(r.gougeTolerance));
   out += fmt::format("<text x=\"{}\" y=\"{}\">{}</text>\n", px(barX + 26.0), px(gougeTop + 4.0),
-                     lengthLabel(std::max(r.maxGouge, r.gougeTolerance)));
+                     lengthLabel(gougeScaleTop));
   const double noneY = gougeTop + 5 * step + 30.0;
   out += fmt::format("<rect x=\"{}\" y=\"{}\" width=\"20\" height=\"{}\" fill=\"{}\"/>\n", px(barX), px(noneY),
                      px(step), kNoSurface);
