@@ -16,6 +16,12 @@
 namespace scallop {
 namespace {
 
+// How far an open pass runs on past the surface's edge, in ball radii, with the drop envelope
+// (see contourPaths). Measured on the paper's surfaces (the simulated cut of the default plan):
+// R, R/2 and R/4 leave the same scallops at the edges (max 1.5-1.7 H, against 2.6 H without),
+// R/4 for 5 % more path instead of 20 %.
+constexpr double kOverrun = 0.25;
+
 void requirePositive(const char* what, double value) {
   if (!(value > 0.0) || !std::isfinite(value))
     throw Error(fmt::format("{} must be a positive number, got {}", what, value));
@@ -179,6 +185,25 @@ ContourPaths contourPaths(const Surface& surface, const ContourOptions& options)
           pass.moves.push_back({MoveKind::line, centre, {}, ArcPlane::xy, true});
         }
         previous = centre;
+      }
+      // With the drop envelope, an open pass runs on past the surface's edge by R along its
+      // end directions: where the planes cross an edge obliquely, the edge between two pass
+      // ends is otherwise cut from one side only (the simulated cut of paper-1 found scallops
+      // of 2.6 H in those wedges). The envelope lifts the overrun clear of the surface.
+      if (options.dropEnvelope && !curve.closed && !pass.moves.empty()) {
+        const Vec3 second = pass.moves.front().end;
+        const Vec3 towardsStart = pass.start - second;
+        if (norm(towardsStart) > 0.0) {
+          const Vec3 before = pass.start + kOverrun * options.toolRadius * normalized(towardsStart);
+          pass.moves.insert(pass.moves.begin(), {MoveKind::line, pass.start, {}, ArcPlane::xy, true});
+          pass.start = before;
+        }
+        const Vec3 last = pass.moves.back().end;
+        const Vec3 penultimate = pass.moves.size() >= 2 ? pass.moves[pass.moves.size() - 2].end : pass.start;
+        const Vec3 onward = last - penultimate;
+        if (norm(onward) > 0.0) {
+          pass.moves.push_back({MoveKind::line, last + kOverrun * options.toolRadius * normalized(onward), {}, ArcPlane::xy, true});
+        }
       }
       if (!pass.moves.empty()) out.path.passes.push_back(std::move(pass));
     }

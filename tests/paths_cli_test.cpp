@@ -200,8 +200,9 @@ TEST_F(PathsCli, PlanGcodeIsAcceptedByLinuxCnc) {
 }
 
 TEST_F(PathsCli, PathsWritesJsonToStandardOutputByDefault) {
+  // The paper's paths: the centres r + R n, not lifted (nor run on past the edges).
   const RunResult result = run("paths --example paper-2 --tool-radius 0.25 --spacing 0.0267 "
-                               "--normal 0.975,-0.221,-0.002");
+                               "--normal 0.975,-0.221,-0.002 --no-drop-envelope");
   ASSERT_EQ(result.exitCode, 0) << result.err;
   const auto report = nlohmann::json::parse(result.out);
   // Table 1 of the paper, last row: 359.23 in and 134 components.

@@ -16,7 +16,10 @@
 //         section curve through the centres r + R n at the curve's vertices (n the unit
 //         normal at the vertex's (u, v), turned up at each point: n_z >= 0, the side a ball
 //         from above reaches); passes follow the planes in increasing k, each entered from
-//         the safe height. By default (dropEnvelope) each pass is then lifted to the drop
+//         the safe height. With dropEnvelope an open pass (a curve ending on the surface's
+//         edge) runs on R/4 past each end along its end direction: where the planes cross an
+//         edge obliquely the edge between two pass ends is otherwise cut from one side only.
+//         By default (dropEnvelope) each pass is then lifted to the drop
 //         envelope (envelope.hpp): a centre that would cut in (a concave radius below R, a
 //         crease, another part of the surface within R, a chord sagging below the offset)
 //         rises straight up to the lowest position proven clear, and every move is proven to
