@@ -107,59 +107,22 @@ double localDropHeight(const BezierPatch& patch, double& u, double& v, double X,
   return at.g;
 }
 
-// A point of an arc move (from `start`): t in [0, 1] of its sweep.
-struct ArcGeometry {
-  ArcPlane plane = ArcPlane::xy;
-  Vec3 center;     // in the plane's frame (e1, e2, n)
-  double radius = 0.0;
-  double angle0 = 0.0;
-  double sweep = 0.0;  // signed: counter-clockwise positive
-  double n0 = 0.0, n1 = 0.0;
-};
-
-ArcGeometry arcGeometry(Vec3 start, const ToolMove& move) {
-  ArcGeometry arc;
-  arc.plane = move.plane;
-  const Vec3 a = toArcPlane(move.plane, start - move.center);
-  const Vec3 b = toArcPlane(move.plane, move.end - move.center);
-  arc.center = move.center;
-  arc.radius = 0.5 * (std::hypot(a.x, a.y) + std::hypot(b.x, b.y));
-  arc.angle0 = std::atan2(a.y, a.x);
-  double sweep = std::atan2(b.y, b.x) - arc.angle0;
-  const double turn = 2.0 * std::numbers::pi;
-  if (move.clockwise) {
-    while (sweep >= 0.0) sweep -= turn;
-  } else {
-    while (sweep <= 0.0) sweep += turn;
+// Above every control point by R: every surface point is at least R below a ball centre
+// there, so at least R away. A relative hair more for the rounding of the comparison.
+double ballTop(const Surface& surface, double radius) {
+  double top = -kInfinity;
+  for (const BezierPatch& patch : surface.patches) {
+    for (const Vec3& p : patch.control) top = std::max(top, p.z);
   }
-  arc.sweep = sweep;
-  arc.n0 = a.z;
-  arc.n1 = b.z;
-  return arc;
-}
-
-Vec3 arcPoint(const ArcGeometry& arc, double t) {
-  const double angle = arc.angle0 + t * arc.sweep;
-  const Vec3 local{arc.radius * std::cos(angle), arc.radius * std::sin(angle),
-                   arc.n0 + t * (arc.n1 - arc.n0)};
-  return arc.center + fromArcPlane(arc.plane, local);
+  return top + radius * (1.0 + 1e-9) + 1e-9 * std::abs(top);
 }
 
 class Lifter {
  public:
-  Lifter(const SurfaceDistance& distance, double radius, double eps, std::size_t maxCells,
+  // `top`: ballTop(surface, R), above which every centre is clear.
+  Lifter(const SurfaceDistance& distance, double radius, double eps, double top, std::size_t maxCells,
          std::size_t& proofs)
-      : distance_(distance), radius_(radius), eps_(eps), maxCells_(maxCells), proofs_(proofs) {
-    double top = -kInfinity;
-    for (const BezierPatch& patch : distance.surface().patches) {
-      for (const Vec3& p : patch.control) top = std::max(top, p.z);
-    }
-    // Above every control point by R: every surface point is at least R below, so at least
-    // R away. A relative hair more for the rounding of the comparison.
-    top_ = top + radius * (1.0 + 1e-9) + 1e-9 * std::abs(top);
-  }
-
-  double top() const { return top_; }
+      : distance_(distance), radius_(radius), eps_(eps), maxCells_(maxCells), proofs_(proofs), top_(top) {}
 
   // Whether the ball and its shank over (x, y) from height z up are proven clear by
   // R - eps / 2; the refuting (or nearest) point is kept as a seed.
@@ -232,7 +195,7 @@ class Lifter {
   double eps_;
   std::size_t maxCells_;
   std::size_t& proofs_;
-  double top_ = 0.0;
+  double top_;
   struct Contact {
     double z = -kInfinity;
     double u = 0.0, v = 0.0;
@@ -280,7 +243,7 @@ struct PassLift {
 };
 
 PassLift liftPass(const SurfaceDistance& distance, const ToolPass& pass, std::size_t passIndex,
-                  double radius, double eps, const EnvelopeOptions& options) {
+                  double radius, double eps, double top, const EnvelopeOptions& options) {
   PassLift result;
   if (!isFinite(pass.start)) {
     throw Error(fmt::format("drop envelope: pass {}: the start is not finite", passIndex));
@@ -289,12 +252,12 @@ PassLift liftPass(const SurfaceDistance& distance, const ToolPass& pass, std::si
   builder.maxMoves = options.maxMoves;
   ToolPass& lifted = result.pass;
   lifted.retractBefore = pass.retractBefore;
-  Lifter lifter(distance, radius, eps, options.maxCellsPerProof, result.proofs);
+  Lifter lifter(distance, radius, eps, top, options.maxCellsPerProof, result.proofs);
   // The pass's first and last vertices are lifted cold (a Lifter of their own, with no
   // contact carried over): a pass fed from the previous one's end then starts exactly where
   // that end was lifted to, whichever thread lifted which.
   const auto liftCold = [&](Vec3 p) {
-    Lifter cold(distance, radius, eps, options.maxCellsPerProof, result.proofs);
+    Lifter cold(distance, radius, eps, top, options.maxCellsPerProof, result.proofs);
     return cold.lift(p);
   };
   lifted.start = liftCold(pass.start);
@@ -345,8 +308,8 @@ PassLift liftPass(const SurfaceDistance& distance, const ToolPass& pass, std::si
       // Each chord's sagitta, exactly: r (1 - cos(sweep / 2k)).
       const double chordSagitta = arc.radius * (1.0 - std::cos(0.5 * std::abs(arc.sweep) / static_cast<double>(count)));
       for (std::size_t i = 0; keep && i < count; ++i) {
-        const Vec3 a = i == 0 ? at : arcPoint(arc, static_cast<double>(i) / static_cast<double>(count));
-        const Vec3 b = i + 1 == count ? move.end : arcPoint(arc, static_cast<double>(i + 1) / static_cast<double>(count));
+        const Vec3 a = i == 0 ? at : pointOnArc(arc, static_cast<double>(i) / static_cast<double>(count));
+        const Vec3 b = i + 1 == count ? move.end : pointOnArc(arc, static_cast<double>(i + 1) / static_cast<double>(count));
         keep = lifter.segmentClear(a, b, eps - chordSagitta);
       }
       if (keep) {
@@ -357,7 +320,7 @@ PassLift liftPass(const SurfaceDistance& distance, const ToolPass& pass, std::si
         // Points of the arc a chord apart, each lifted, then refined as lines.
         Vec3 from = liftedAt;
         for (std::size_t i = 1; i <= count; ++i) {
-          const Vec3 onArc = i == count ? move.end : arcPoint(arc, static_cast<double>(i) / static_cast<double>(count));
+          const Vec3 onArc = i == count ? move.end : pointOnArc(arc, static_cast<double>(i) / static_cast<double>(count));
           const Vec3 raised = i == count ? end : lifter.lift(onArc);
           refineLine(refineLine, from, raised, i == count ? endLift : raised.z - onArc.z, 0);
           from = raised;
@@ -409,13 +372,14 @@ ToolPath liftToDropEnvelope(const SurfaceDistance& distance, const ToolPath& pat
   // The passes are independent (each lifts its own vertices with its own Lifter; the first
   // and last cold, see liftPass), so they are lifted on every core, and the result is the
   // same for any number of threads.
+  const double top = ballTop(distance.surface(), radius);
   std::vector<PassLift> lifts(path.passes.size());
   std::vector<std::exception_ptr> errors(path.passes.size());
   std::atomic<std::size_t> nextPass{0};
   const auto work = [&] {
     for (std::size_t i = nextPass++; i < path.passes.size(); i = nextPass++) {
       try {
-        lifts[i] = liftPass(distance, path.passes[i], i, radius, eps, options);
+        lifts[i] = liftPass(distance, path.passes[i], i, radius, eps, top, options);
       } catch (...) {
         errors[i] = std::current_exception();
       }

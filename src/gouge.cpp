@@ -378,6 +378,38 @@ struct Scratch {
   std::vector<Vec3> arena;
 };
 
+// Offers the four quarters of `cell` (subdivided at 1/2 in u and v): from the patch's tree
+// while it goes that deep, else halved into the query's arena.
+template <typename Offer>
+void offerQuarters(const Cell& cell, const PatchTree& tree, std::vector<Vec3>& arena, const Offer& offer) {
+  const double half = std::ldexp(0.5, -cell.depth);
+  if (cell.inTree && cell.depth + 1 < tree.levels) {
+    const auto side = std::size_t{1} << cell.depth;
+    const std::size_t iu = cell.net / side;
+    const std::size_t iv = cell.net % side;
+    for (std::size_t a = 0; a < 2; ++a) {
+      for (std::size_t b = 0; b < 2; ++b) {
+        offer(Cell{0.0, cell.patch, cell.depth + 1, true, (2 * iu + a) * (2 * side) + (2 * iv + b),
+                   cell.u0 + static_cast<double>(a) * half, cell.v0 + static_cast<double>(b) * half});
+      }
+    }
+    return;
+  }
+  const std::size_t stride = tree.stride;
+  const std::size_t first = arena.size();
+  arena.resize(first + 4 * stride);  // may move the arena: take the parent's net after
+  const Vec3* parent = cell.inTree
+                           ? tree.nets[static_cast<std::size_t>(cell.depth)].data() + cell.net * stride
+                           : arena.data() + cell.net;
+  halveNet(parent, tree.degreeU, tree.degreeV, arena.data() + first);
+  for (std::size_t a = 0; a < 2; ++a) {
+    for (std::size_t b = 0; b < 2; ++b) {
+      offer(Cell{0.0, cell.patch, cell.depth + 1, false, first + (2 * a + b) * stride,
+                 cell.u0 + static_cast<double>(a) * half, cell.v0 + static_cast<double>(b) * half});
+    }
+  }
+}
+
 void checkSurface(const Surface& surface) {
   if (surface.patches.empty()) throw Error("surface distance: the surface has no patches");
   for (std::size_t i = 0; i < surface.patches.size(); ++i) {
@@ -548,29 +580,7 @@ ClosestPoint search(const Surface& surface, const std::vector<PatchTree>& trees,
       lowerBound = cell.lower;
       break;
     }
-    const double half = 0.5 * h;
-    const std::size_t stride = tree.stride;
-    if (cell.inTree && cell.depth + 1 < tree.levels) {
-      const auto side = std::size_t{1} << cell.depth;
-      const std::size_t iu = cell.net / side;
-      const std::size_t iv = cell.net % side;
-      for (std::size_t a = 0; a < 2; ++a) {
-        for (std::size_t b = 0; b < 2; ++b) {
-          offer({0.0, cell.patch, cell.depth + 1, true, (2 * iu + a) * (2 * side) + (2 * iv + b),
-                 cell.u0 + static_cast<double>(a) * half, cell.v0 + static_cast<double>(b) * half});
-        }
-      }
-    } else {
-      const std::size_t first = arena.size();
-      arena.resize(first + 4 * stride);  // may move the arena: take the parent's net after
-      halveNet(netOf(cell), tree.degreeU, tree.degreeV, arena.data() + first);
-      for (std::size_t a = 0; a < 2; ++a) {
-        for (std::size_t b = 0; b < 2; ++b) {
-          offer({0.0, cell.patch, cell.depth + 1, false, first + (2 * a + b) * stride,
-                 cell.u0 + static_cast<double>(a) * half, cell.v0 + static_cast<double>(b) * half});
-        }
-      }
-    }
+    offerQuarters(cell, tree, arena, offer);
   }
 
   ClosestPoint result;
@@ -695,34 +705,11 @@ SegmentClearance segmentSearch(const std::vector<PatchTree>& trees, Vec3 a, Vec3
     const Cell cell = heap.back();
     heap.pop_back();
     const PatchTree& tree = trees[cell.patch];
-    const double h = std::ldexp(1.0, -cell.depth);
     if (cell.depth >= kMaxCellDepth || result.cells >= maxCells) {
       result.verdict = Clearance::undecided;
       return result;
     }
-    const double half = 0.5 * h;
-    const std::size_t stride = tree.stride;
-    if (cell.inTree && cell.depth + 1 < tree.levels) {
-      const auto side = std::size_t{1} << cell.depth;
-      const std::size_t iu = cell.net / side;
-      const std::size_t iv = cell.net % side;
-      for (std::size_t i = 0; i < 2; ++i) {
-        for (std::size_t j = 0; j < 2; ++j) {
-          offer({0.0, cell.patch, cell.depth + 1, true, (2 * iu + i) * (2 * side) + (2 * iv + j),
-                 cell.u0 + static_cast<double>(i) * half, cell.v0 + static_cast<double>(j) * half});
-        }
-      }
-    } else {
-      const std::size_t first = arena.size();
-      arena.resize(first + 4 * stride);  // may move the arena: take the parent's net after
-      halveNet(netOf(cell), tree.degreeU, tree.degreeV, arena.data() + first);
-      for (std::size_t i = 0; i < 2; ++i) {
-        for (std::size_t j = 0; j < 2; ++j) {
-          offer({0.0, cell.patch, cell.depth + 1, false, first + (2 * i + j) * stride,
-                 cell.u0 + static_cast<double>(i) * half, cell.v0 + static_cast<double>(j) * half});
-        }
-      }
-    }
+    offerQuarters(cell, tree, arena, offer);
   }
   result.verdict = violated ? Clearance::violated : Clearance::proven;
   return result;

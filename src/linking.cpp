@@ -28,26 +28,7 @@ double resolved(const char* name, double value, double fallback) {
   return value > 0.0 ? value : fallback;
 }
 
-Vec3 passEnd(const ToolPass& pass) {
-  return pass.moves.empty() ? pass.start : pass.moves.back().end;
-}
-
 bool isClosed(const ToolPass& pass) { return pass.moves.size() >= 2 && passEnd(pass) == pass.start; }
-
-// The same path run backwards: moves in reverse order, each ending where its predecessor
-// began, arcs turning the other way (about the same centre, in the same plane).
-ToolPass reversed(const ToolPass& pass) {
-  ToolPass out;
-  out.retractBefore = pass.retractBefore;
-  out.start = passEnd(pass);
-  for (std::size_t i = pass.moves.size(); i-- > 0;) {
-    ToolMove move = pass.moves[i];
-    move.end = i == 0 ? pass.start : pass.moves[i - 1].end;
-    if (move.kind == MoveKind::arc) move.clockwise = !move.clockwise;
-    out.moves.push_back(move);
-  }
-  return out;
-}
 
 // A closed pass started at its k-th vertex (0: start, k: the end of move k - 1): the same
 // loop, the same direction.
@@ -184,7 +165,7 @@ LinkedPath linkToolPath(const Surface& surface, const ToolPath& path, const Link
     for (std::size_t i = u.first; i < u.first + u.count; ++i) {
       ToolPass pass = path.passes[i];
       if (e.reverse) {
-        pass = reversed(pass);
+        pass = reversedPass(pass);
         ++out.stats.reversedPasses;
       } else if (e.vertex > 0) {
         pass = rotated(pass, e.vertex);

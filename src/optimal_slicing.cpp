@@ -1301,12 +1301,16 @@ class CoarseToFineDomain {
 
 }  // namespace
 
-bool certifyClearance(const Surface& surface, const Vec3& n, double lowerBoundRad,
-                      std::size_t& cells, int maxDepth) {
+namespace {
+
+// certifyClearance on a surface whose corners are resolved already (cornerPieces): the
+// optimal slicing's bisection calls it up to kCertificateBisections times on the same pieces.
+bool certifyPieces(const Surface& pieces, const Vec3& n, double lowerBoundRad, std::size_t& cells,
+                   int maxDepth) {
   if (!(lowerBoundRad > 0.0)) return true;
   const Vec3 m = normalized(n);
   const double c = std::cos(lowerBoundRad);
-  for (const BezierPatch& patch : cornerResolved(surface).patches) {
+  for (const BezierPatch& patch : pieces.patches) {
     // q, N's direction field (collapsed edges factored out), for N: the same directions, and
     // on an apex row their limits, which the certificate must cover too.
     const std::array<Bernstein2, 3> normal = normalDirectionPolynomials(patch).polynomials;
@@ -1320,6 +1324,13 @@ bool certifyClearance(const Surface& surface, const Vec3& n, double lowerBoundRa
     if (!provePositive(p, 0, maxDepth, cells)) return false;
   }
   return true;
+}
+
+}  // namespace
+
+bool certifyClearance(const Surface& surface, const Vec3& n, double lowerBoundRad,
+                      std::size_t& cells, int maxDepth) {
+  return certifyPieces(cornerResolved(surface), n, lowerBoundRad, cells, maxDepth);
 }
 
 BestCircles bestCircles(const PlanarDomain& domain, const BestCirclesOptions& options) {
@@ -1379,8 +1390,9 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
                             0.1 * 180.0 / std::numbers::pi, tol * 180.0 / std::numbers::pi));
   }
   validateSurface(surface);
-  // The polish climbs on pieces without corners where q vanishes (its heights divide by
-  // |q|); the Gauss map, the coverage proof and the certificate resolve them themselves.
+  // The polish and the certificate work on pieces without corners where q vanishes (the
+  // polish's heights divide by |q|); the Gauss map and the coverage proof resolve them
+  // themselves, naming the source patches in their errors.
   const Surface working = cornerResolved(surface);
   OptimalSlicing result;
   GaussMapOptions gaussOptions;
@@ -1530,8 +1542,8 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
   // sampled-and-climbed maxima could have missed) of +-N*.
   if (options.certify) {
     result.certifiedAlphaRad = std::max(0.0, result.alphaRad - kCertificateMarginRad);
-    result.certified = certifyClearance(surface, result.normal, result.certifiedAlphaRad,
-                                        result.certificateCells);
+    result.certified = certifyPieces(working, result.normal, result.certifiedAlphaRad,
+                                     result.certificateCells, kCertificateMaxDepth);
     if (!result.certified) {
       // The polish's contacts missed a normal nearer to N* (a fold where the normal turns
       // fast, say): the claim falls, and what is proven at N* becomes the answer, found by
@@ -1542,7 +1554,7 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
       double proven = 0.0, refuted = result.certifiedAlphaRad;
       for (int step = 0; step < kCertificateBisections && refuted - proven > 1e-12; ++step) {
         const double middle = 0.5 * (proven + refuted);
-        if (certifyClearance(surface, result.normal, middle, result.certificateCells)) {
+        if (certifyPieces(working, result.normal, middle, result.certificateCells, kCertificateMaxDepth)) {
           proven = middle;
         } else {
           refuted = middle;

@@ -52,14 +52,10 @@ void appendArc(const Vec3& from, const ToolMove& move, std::vector<Vec3>& out) {
   // The plane's in-plane axes, a x b its positive normal (toolpath.hpp).
   const Vec3 a = fromArcPlane(move.plane, {1.0, 0.0, 0.0});
   const Vec3 b = fromArcPlane(move.plane, {0.0, 1.0, 0.0});
-  const Vec3 s = from - move.center, e = move.end - move.center;
-  const double a0 = std::atan2(dot(s, b), dot(s, a));
-  double sweep = std::atan2(dot(e, b), dot(e, a)) - a0;
-  if (move.clockwise) {
-    while (sweep >= 0.0) sweep -= 2.0 * std::numbers::pi;
-  } else {
-    while (sweep <= 0.0) sweep += 2.0 * std::numbers::pi;
-  }
+  const Vec3 s = from - move.center;
+  const ArcGeometry arc = arcGeometry(from, move);
+  const double a0 = arc.startAngle;
+  const double sweep = arc.sweep;
   const double radius = norm(s);
   const Vec3 normal = cross(a, b);
   const double level = dot(from, normal);

@@ -295,22 +295,6 @@ ToolPass passFromHull(const ScallopHull& hull, const Frame& f, double w, double 
   return pass;
 }
 
-// The same path run backwards: moves in reverse order, each ending where its predecessor
-// began, arcs turning the other way.
-ToolPass reversedPass(const ToolPass& pass) {
-  ToolPass out;
-  out.retractBefore = pass.retractBefore;
-  out.start = pass.moves.empty() ? pass.start : pass.moves.back().end;
-  for (std::size_t i = pass.moves.size(); i-- > 0;) {
-    ToolMove move = pass.moves[i];
-    move.end = i == 0 ? pass.start : pass.moves[i - 1].end;
-    if (move.kind == MoveKind::arc) move.clockwise = !move.clockwise;
-    out.moves.push_back(move);
-  }
-  return out;
-}
-
-Vec3 passEnd(const ToolPass& pass) { return pass.moves.empty() ? pass.start : pass.moves.back().end; }
 
 // ---------------------------------------------------------------------------------------
 // Ways off the surface at a pass's ends
@@ -490,20 +474,6 @@ double bestRasterAngle(const Surface& surface) {
 }
 
 namespace {
-
-double moveLength(Vec3 from, const ToolMove& move) {
-  if (move.kind == MoveKind::line) return norm(move.end - from);
-  const Vec3 a = toArcPlane(move.plane, from - move.center);
-  const Vec3 b = toArcPlane(move.plane, move.end - move.center);
-  double sweep = std::atan2(b.y, b.x) - std::atan2(a.y, a.x);
-  const double turn = 2.0 * std::numbers::pi;
-  if (move.clockwise) {
-    while (sweep >= 0.0) sweep -= turn;
-  } else {
-    while (sweep <= 0.0) sweep += turn;
-  }
-  return std::hypot(0.5 * (std::hypot(a.x, a.y) + std::hypot(b.x, b.y)) * sweep, b.z - a.z);
-}
 
 // The passes lifted to the drop envelope; the move counts of RasterPass and the lengths
 // recomputed on the lifted moves.

@@ -187,6 +187,20 @@ double normalLengthAt(const BezierPatch& patch, double u, double v) {
 
 namespace {
 
+// The patch scaled by a power of two (exact, barring underflow of coordinates far below the
+// largest) so that its largest |coordinate| lies in [0.5, 1): the squares and fourth powers
+// of the regularity check can then neither overflow nor underflow, and its verdicts are
+// invariant under scaling by powers of two.
+BezierPatch scaledToUnit(const BezierPatch& original) {
+  int exponent = 0;
+  std::frexp(patchScale(original), &exponent);
+  BezierPatch patch = original;
+  for (Vec3& p : patch.control) {
+    p = {std::ldexp(p.x, -exponent), std::ldexp(p.y, -exponent), std::ldexp(p.z, -exponent)};
+  }
+  return patch;
+}
+
 // Degrees >= 1 and (m + 1)(n + 1) finite control points, or scallop::Error from `what`.
 void requireWellFormed(const BezierPatch& patch, const char* what) {
   const bool shaped = patch.degreeU >= 1 && patch.degreeV >= 1 &&
@@ -206,16 +220,7 @@ void requireWellFormed(const BezierPatch& patch, const char* what) {
 // The regularity check proper (the contract's quadtree), on a patch whose corners are not
 // singular, or that is itself a corner piece.
 PatchRegularity checkPieceRegularity(const BezierPatch& original) {
-  // Work on the patch scaled by a power of two (exact, barring underflow of coordinates
-  // far below the largest) so that its largest |coordinate| lies in [0.5, 1): the squares
-  // and fourth powers below can then neither overflow nor underflow, and the verdict is
-  // invariant under scaling by powers of two.
-  int exponent = 0;
-  std::frexp(patchScale(original), &exponent);
-  BezierPatch patch = original;
-  for (Vec3& p : patch.control) {
-    p = {std::ldexp(p.x, -exponent), std::ldexp(p.y, -exponent), std::ldexp(p.z, -exponent)};
-  }
+  const BezierPatch patch = scaledToUnit(original);
   const double scale = patchScale(patch);
   PatchRegularity result;
   result.threshold = kRelativeNormalTolerance;
@@ -309,12 +314,7 @@ double cornerV(int corner) { return (corner & 2) ? 1.0 : 0.0; }
 // kRelativeNormalTolerance scale^2 of 0, as bits 1 << corner. Decided on the patch scaled by
 // a power of two (exact), as the regularity check: no overflow, the same verdict.
 unsigned singularCorners(const BezierPatch& original) {
-  int exponent = 0;
-  std::frexp(patchScale(original), &exponent);
-  BezierPatch patch = original;
-  for (Vec3& p : patch.control) {
-    p = {std::ldexp(p.x, -exponent), std::ldexp(p.y, -exponent), std::ldexp(p.z, -exponent)};
-  }
+  const BezierPatch patch = scaledToUnit(original);
   const double scale = patchScale(patch);
   const double tau = kRelativeNormalTolerance * scale * scale;
   const std::array<Bernstein2, 3>& q = normalDirectionPolynomials(patch).polynomials;

@@ -85,25 +85,29 @@ inline std::vector<Vec3> sampleRegularNormals(const Surface& s, int samples) {
       }
     }
     const double tiny = 1e-12 * su * sv;
+    // The unit normal from the basis values in u (bu, du: degrees m and m - 1) and in v, kept
+    // where r_u x r_v is not singular.
+    auto addNormal = [&](const std::vector<double>& bu, const std::vector<double>& du,
+                         const std::vector<double>& bv, const std::vector<double>& dv) {
+      Vec3 ru{0.0, 0.0, 0.0};
+      Vec3 rv{0.0, 0.0, 0.0};
+      for (int j = 0; j <= m; ++j) {
+        for (int k = 0; k <= n; ++k) {
+          if (j < m) ru = ru + (m * du[j] * bv[k]) * (p.at(j + 1, k) - p.at(j, k));
+          if (k < n) rv = rv + (n * bu[j] * dv[k]) * (p.at(j, k + 1) - p.at(j, k));
+        }
+      }
+      const Vec3 normal = cross(ru, rv);
+      const double length = norm(normal);
+      if (length > tiny) out.push_back(normal / length);
+    };
     for (int a = 0; a <= samples; ++a) {
       const double u = double(a) / samples;
       const std::vector<double> bu = basis(m, u);
       const std::vector<double> du = basis(m - 1, u);
       for (int c = 0; c <= samples; ++c) {
         const double v = double(c) / samples;
-        const std::vector<double> bv = basis(n, v);
-        const std::vector<double> dv = basis(n - 1, v);
-        Vec3 ru{0.0, 0.0, 0.0};
-        Vec3 rv{0.0, 0.0, 0.0};
-        for (int j = 0; j <= m; ++j) {
-          for (int k = 0; k <= n; ++k) {
-            if (j < m) ru = ru + (m * du[j] * bv[k]) * (p.at(j + 1, k) - p.at(j, k));
-            if (k < n) rv = rv + (n * bu[j] * dv[k]) * (p.at(j, k + 1) - p.at(j, k));
-          }
-        }
-        const Vec3 normal = cross(ru, rv);
-        const double length = norm(normal);
-        if (length > tiny) out.push_back(normal / length);
+        addNormal(bu, du, basis(n, v), basis(n - 1, v));
       }
     }
     // Rays into each corner at 1e-6 of the parameter range: where r_u x r_v vanishes at a
@@ -115,19 +119,7 @@ inline std::vector<Vec3> sampleRegularNormals(const Surface& s, int samples) {
         const double theta = 0.5 * std::numbers::pi * a / samples;
         const double u = u0 + (1.0 - 2.0 * u0) * 1e-6 * std::cos(theta);
         const double v = v0 + (1.0 - 2.0 * v0) * 1e-6 * std::sin(theta);
-        const std::vector<double> bu = basis(m, u), du = basis(m - 1, u);
-        const std::vector<double> bv = basis(n, v), dv = basis(n - 1, v);
-        Vec3 ru{0.0, 0.0, 0.0};
-        Vec3 rv{0.0, 0.0, 0.0};
-        for (int j = 0; j <= m; ++j) {
-          for (int k = 0; k <= n; ++k) {
-            if (j < m) ru = ru + (m * du[j] * bv[k]) * (p.at(j + 1, k) - p.at(j, k));
-            if (k < n) rv = rv + (n * bu[j] * dv[k]) * (p.at(j, k + 1) - p.at(j, k));
-          }
-        }
-        const Vec3 normal = cross(ru, rv);
-        const double length = norm(normal);
-        if (length > tiny) out.push_back(normal / length);
+        addNormal(basis(m, u), basis(m - 1, u), basis(n, v), basis(n - 1, v));
       }
     }
   }

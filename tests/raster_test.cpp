@@ -82,12 +82,12 @@ Vec3 fromPlane(ArcPlane plane, Vec2 q, double n) {
   return {};
 }
 
-struct ArcGeometry {
+struct ReferenceArc {
   double radius, startAngle, sweep;  // sweep > 0, in the move's turning sense
   bool clockwise;
 };
 
-ArcGeometry arcGeometry(Vec3 from, const ToolMove& m) {
+ReferenceArc referenceArc(Vec3 from, const ToolMove& m) {
   const Vec2 a = inPlane(m.plane, from) - inPlane(m.plane, m.center);
   const Vec2 b = inPlane(m.plane, m.end) - inPlane(m.plane, m.center);
   const double a0 = std::atan2(a.y, a.x), a1 = std::atan2(b.y, b.x);
@@ -97,7 +97,7 @@ ArcGeometry arcGeometry(Vec3 from, const ToolMove& m) {
   return {scallop::norm(a), a0, sweep, m.clockwise};
 }
 
-Vec3 arcPoint(const ToolMove& m, const ArcGeometry& g, double t) {
+Vec3 arcPoint(const ToolMove& m, const ReferenceArc& g, double t) {
   const double angle = g.startAngle + (g.clockwise ? -1.0 : 1.0) * t * g.sweep;
   const Vec2 c = inPlane(m.plane, m.center);
   return fromPlane(m.plane, {c.x + g.radius * std::cos(angle), c.y + g.radius * std::sin(angle)},
@@ -110,7 +110,7 @@ std::vector<Vec3> sampleMove(Vec3 from, const ToolMove& m, int pieces) {
   if (m.kind == MoveKind::line) {
     for (int i = 0; i <= pieces; ++i) out.push_back(from + (double(i) / pieces) * (m.end - from));
   } else {
-    const ArcGeometry g = arcGeometry(from, m);
+    const ReferenceArc g = referenceArc(from, m);
     for (int i = 0; i <= pieces; ++i) out.push_back(arcPoint(m, g, double(i) / pieces));
   }
   return out;
@@ -362,7 +362,7 @@ Checked checkRaster(const Surface& surface, const RasterPaths& r, double angle, 
         // The plane's own coordinate is the same for both ends and the centre.
         EXPECT_EQ(acrossPlane(m.plane, at), acrossPlane(m.plane, m.center)) << mw;
         EXPECT_EQ(acrossPlane(m.plane, m.end), acrossPlane(m.plane, m.center)) << mw;
-        const ArcGeometry g = arcGeometry(at, m);
+        const ReferenceArc g = referenceArc(at, m);
         EXPECT_NEAR(g.radius, R, 1e-9 * scale) << mw;
         EXPECT_NEAR(scallop::norm(m.end - m.center), R, 1e-9 * scale) << mw;
         // The hull's arcs roll over a convex vertex: less than half a turn.

@@ -195,7 +195,8 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
 /// proven at least `lowerBoundRad` when the return is true: the Bernstein-form certificate
 /// (see the contract), subdividing each patch while needed, up to `maxDepth`. `cells`
 /// counts the cells examined.
+constexpr int kCertificateMaxDepth = 14;
 bool certifyClearance(const Surface& surface, const Vec3& n, double lowerBoundRad,
-                      std::size_t& cells, int maxDepth = 14);
+                      std::size_t& cells, int maxDepth = kCertificateMaxDepth);
 
 }  // namespace scallop

@@ -78,6 +78,27 @@ struct LocalRetract {
   double plunge = 0.0;  ///< d: the last part of the descent, made at the plunge feed
 };
 
+/// An arc move from `start` in its plane's frame (toArcPlane): the centre, the radius (the mean
+/// of the two ends' distances from the centre), the start's angle, the signed sweep in
+/// radians (counter-clockwise seen from the normal's positive end positive: in (0, 2 pi] for
+/// G3, [-2 pi, 0) for G2; start == end is a full turn), and the start's and end's coordinate
+/// along the normal (equal but for rounding; a helix in between).
+struct ArcGeometry {
+  ArcPlane plane = ArcPlane::xy;
+  Vec3 center;
+  double radius = 0.0;
+  double startAngle = 0.0;
+  double sweep = 0.0;
+  double startLevel = 0.0;
+  double endLevel = 0.0;
+};
+ArcGeometry arcGeometry(Vec3 start, const ToolMove& arc);
+/// The arc's point at the fraction t in [0, 1] of its sweep.
+Vec3 pointOnArc(const ArcGeometry& arc, double t);
+/// The length of a move from `start`: a line's chord, an arc's r |sweep| (with the rise along
+/// the normal of a helix).
+double moveLength(Vec3 start, const ToolMove& move);
+
 struct ToolPass {
   Vec3 start;                   ///< tool centre where the pass begins
   std::vector<ToolMove> moves;  ///< each from the previous end (or `start`) to its `end`
@@ -85,6 +106,12 @@ struct ToolPass {
   /// With retractBefore: a local retract; absent: via the safe height (see above).
   std::optional<LocalRetract> retract = std::nullopt;
 };
+
+/// Where the pass ends: its last move's end, or its start when it has no move.
+Vec3 passEnd(const ToolPass& pass);
+/// The same path run backwards: moves in reverse order, each ending where its predecessor
+/// began, arcs turning the other way (about the same centre, in the same plane).
+ToolPass reversedPass(const ToolPass& pass);
 
 struct ToolPath {
   Units units = Units::inch;
