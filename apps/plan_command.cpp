@@ -134,6 +134,7 @@ void runPlan(const PlanOptions& options) {
                                             simulated.gougeTolerance, simulated.maxScallop,
                                             simulated.maxScallopAt, simulated.scallopP99,
                                             simulated.meanScallop, simulated.uncutArea,
+                                            simulated.unreachableArea, simulated.maxUnreachableScallop,
                                             simulated.rapidsCutting, simulated.seconds};
   std::vector<OutputFile> outputs{
       {(dir / programName).string(), program},
@@ -162,9 +163,13 @@ void runPlan(const PlanOptions& options) {
              orientation.normal.z, orientation.alphaRad * 180.0 / std::numbers::pi, report.spacing,
              s.planes, s.components, s.centreLength, unitsName(surface.units), gouge,
              cycleSummary(report, surface.units) +
-                 fmt::format("; simulated: gouge {:.6f}, scallop max {:.6f} / 99% {:.6f} {}",
+                 fmt::format("; simulated: gouge {:.6f}, scallop max {:.6f} / 99% {:.6f} {}{}",
                              simulated.maxGouge, simulated.maxScallop, simulated.scallopP99,
-                             unitsName(surface.units)),
+                             unitsName(surface.units),
+                             simulated.unreachablePoints > 0
+                                 ? fmt::format(", {:.4f} {}^2 beyond the ball's reach", simulated.unreachableArea,
+                                               unitsName(surface.units))
+                                 : std::string()),
              report.seconds + orientation.seconds,
              options.out);
 }

@@ -45,7 +45,8 @@ void checkGouge(const Surface& surface, const JobOptions& options, JobResult& re
 // The scallop height on the curved surface (cusp.hpp): with H, the sections are traced to
 // H / 20 (a pass is a chord between exact offset points; where the surface is concave along
 // the pass the chord lies above the true offset curve and leaves up to the chordal tolerance
-// of extra material) and, unless --constant-spacing, the planes are adaptivePlaneOffsets'.
+// of extra material) and, unless --constant-spacing, the planes are adaptivePlaneOffsets'
+// for the cusp H - H / 20.
 struct ScallopPlanes {
   std::vector<double> offsets;  ///< empty: k Delta
   double chordalTolerance = 0.0;  ///< 0: the strategy's default
@@ -53,15 +54,19 @@ struct ScallopPlanes {
 };
 
 ScallopPlanes scallopPlanes(const Surface& surface, const JobOptions& options, const Vec3& normal,
-                            const Progress& progress) {
+                            bool centrePlanes, const Progress& progress) {
   ScallopPlanes out;
   if (!options.scallopHeight || options.constantSpacing) return out;
   out.chordalTolerance =
       std::min(1e-4 * std::max(surfaceScale(surface), 1e-300), *options.scallopHeight / 20.0);
   CuspOptions cusp;
   cusp.toolRadius = options.toolRadius;
-  cusp.scallopHeight = *options.scallopHeight;
+  // A pass is a chord between exact offset points: where the surface is concave along it,
+  // the chord leaves up to the chordal tolerance above the true offset, on top of the cusp
+  // (cusp.hpp), so the cusps are kept below H minus that.
+  cusp.scallopHeight = *options.scallopHeight - out.chordalTolerance;
   cusp.chordalTolerance = out.chordalTolerance;
+  cusp.centrePlanes = centrePlanes;
   say(progress, "choosing plane offsets that keep the cusp below the scallop height on the curved surface");
   AdaptiveOffsets adaptive = adaptivePlaneOffsets(surface, normal, cusp);
   out.offsets = std::move(adaptive.offsets);
@@ -71,7 +76,7 @@ ScallopPlanes scallopPlanes(const Surface& surface, const JobOptions& options, c
 
 ScallopReport scallopReport(const Surface& surface, const JobOptions& options, const Vec3& normal,
                             double flatSpacing, const ScallopPlanes& planes,
-                            const std::vector<PlaneContacts>& used) {
+                            const std::vector<PlaneContacts>& used, bool centrePlanes) {
   ScallopReport report;
   report.adaptive = !planes.offsets.empty();
   report.flatSpacing = flatSpacing;
@@ -92,6 +97,8 @@ ScallopReport scallopReport(const Surface& surface, const JobOptions& options, c
                                 : 1e-4 * std::max(surfaceScale(surface), 1e-300);
   CuspOptions cusp;
   cusp.toolRadius = options.toolRadius;
+  cusp.scallopHeight = options.scallopHeight.value_or(0.0);
+  cusp.centrePlanes = centrePlanes;
   report.cusp = cuspStatistics(surface, normal, used, cusp);
   return report;
 }
@@ -132,11 +139,14 @@ void runContour(const Surface& surface, const JobOptions& options, JobResult& re
   contour.normal = normal;
   contour.toolRadius = options.toolRadius;
   if (options.scallopHeight) contour.stretchThreshold = *options.scallopHeight;
+  // Where the envelope sags between two lifted vertices, a straight move would leave its sag
+  // on top of the cusp: split such moves down to a quarter of H.
+  if (options.scallopHeight) contour.sagTolerance = *options.scallopHeight / 4.0;
   contour.dropEnvelope = options.dropEnvelope;
   contour.spacing = options.spacing ? *options.spacing
                                     : spacingForScallopHeight(options.toolRadius,
                                                               *options.scallopHeight, alpha);
-  const ScallopPlanes planes = scallopPlanes(surface, options, normal, progress);
+  const ScallopPlanes planes = scallopPlanes(surface, options, normal, false, progress);
   contour.planeOffsets = planes.offsets;
   contour.chordalTolerance = planes.chordalTolerance;
   say(progress, planes.offsets.empty()
@@ -146,7 +156,7 @@ void runContour(const Surface& surface, const JobOptions& options, JobResult& re
   if (options.scallopHeight) {
     std::vector<PlaneContacts> used;
     for (const ContourSection& section : paths.sections) used.push_back({section.offset, &section.section});
-    result.report.scallop = scallopReport(surface, options, paths.normal, contour.spacing, planes, used);
+    result.report.scallop = scallopReport(surface, options, paths.normal, contour.spacing, planes, used, false);
   }
   result.report.spacing = paths.spacing;
   result.report.planeNormal = paths.normal;
@@ -164,6 +174,7 @@ void runRaster(const Surface& surface, const JobOptions& options, JobResult& res
   RasterOptions raster;
   raster.toolRadius = options.toolRadius;
   if (options.scallopHeight) raster.stretchThreshold = *options.scallopHeight;
+  if (options.scallopHeight) raster.sagTolerance = *options.scallopHeight / 4.0;
   raster.dropEnvelope = options.dropEnvelope;
   const bool adaptive = options.scallopHeight && !options.constantSpacing;
   if (options.angleDeg) {
@@ -181,7 +192,7 @@ void runRaster(const Surface& surface, const JobOptions& options, JobResult& res
   ScallopPlanes planes;
   if (adaptive) {
     const Vec3 e{-std::sin(raster.angleRad), std::cos(raster.angleRad), 0.0};
-    planes = scallopPlanes(surface, options, e, progress);
+    planes = scallopPlanes(surface, options, e, true, progress);
     raster.planeOffsets = planes.offsets;
     raster.chordalTolerance = planes.chordalTolerance;
   }
@@ -190,7 +201,7 @@ void runRaster(const Surface& surface, const JobOptions& options, JobResult& res
   if (options.scallopHeight) {
     std::vector<PlaneContacts> used;
     for (const RasterSection& section : paths.sections) used.push_back({section.offset, &section.section});
-    result.report.scallop = scallopReport(surface, options, paths.planeNormal, paths.spacing, planes, used);
+    result.report.scallop = scallopReport(surface, options, paths.planeNormal, paths.spacing, planes, used, true);
   }
   result.report.spacing = paths.spacing;
   result.report.planeNormal = paths.planeNormal;
@@ -261,6 +272,7 @@ JobResult runToolpathJob(const Surface& surface, const std::string& source,
       LinkedPath linked = linkToolPath(surface, result.path, linking);
       result.path = std::move(linked.path);
       result.report.linking = linked.stats;
+      result.report.linkMoves = std::move(linked.linkMoves);
     } catch (const Error& error) {
       throw Error(fmt::format("{}: {}", source, error.what()));
     }

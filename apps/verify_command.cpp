@@ -96,6 +96,10 @@ int runVerify(const VerifyOptions& options) {
                    : std::string(),
                report.maxScallop, report.scallopP99, report.meanScallop, units, report.scallopHeight, report.uncutArea,
                units, report.seconds);
+    if (report.unreachablePoints > 0)
+      fmt::print(stderr, "scallop: {}: {:.6g} {}^2 left above H beyond the ball's reach (up to {:.6g} {}): a smaller "
+                 "tool's work, not in the scallop figures\n", sources.program, report.unreachableArea, units,
+                 report.maxUnreachableScallop, units);
     if (report.rapidsCutting > 0)
       fmt::print(stderr, "scallop: {}: {} rapid moves cut material, the first on line {}\n", sources.program,
                  report.rapidsCutting, report.firstRapidCutLine);

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <optional>
 
 #include <fmt/format.h>
 
@@ -15,12 +16,6 @@
 
 namespace scallop {
 namespace {
-
-// How far an open pass runs on past the surface's edge, in ball radii, with the drop envelope
-// (see contourPaths). Measured on the paper's surfaces (the simulated cut of the default plan):
-// R, R/2 and R/4 leave the same scallops at the edges (max 1.5-1.7 H, against 2.6 H without),
-// R/4 for 5 % more path instead of 20 %.
-constexpr double kOverrun = 0.25;
 
 void requirePositive(const char* what, double value) {
   if (!(value > 0.0) || !std::isfinite(value))
@@ -160,10 +155,20 @@ ContourPaths contourPaths(const Surface& surface, const ContourOptions& options)
       explicitOffsets ? PlaneRange{options.planeOffsets.front(), options.planeOffsets.back(), 0.0,
                                    static_cast<double>(options.planeOffsets.size() - 1)}
                       : planeRange(surface, out.normal, options.spacing, "the plane spacing");
+  const auto offsetAt = [&](double kk) {
+    return explicitOffsets ? options.planeOffsets[static_cast<std::size_t>(kk)] : kk * options.spacing;
+  };
+  std::optional<SurfaceDistance> distance;
+  if (options.dropEnvelope) distance.emplace(surface);
   for (double kk = range.first; kk <= range.last; kk += 1.0) {
     const long long k = static_cast<long long>(kk);
-    const double offset = explicitOffsets ? options.planeOffsets[static_cast<std::size_t>(k)]
-                                          : kk * options.spacing;
+    const double offset = offsetAt(kk);
+    // Run-on steps of half the gap to the nearest plane (see raster.cpp).
+    RunOnBand band{out.normal, 0.0};
+    double gap = 4.0 * options.toolRadius;
+    if (kk > range.first) band.lo = 0.5 * (offsetAt(kk - 1.0) + offset), gap = std::min(gap, offset - offsetAt(kk - 1.0));
+    if (kk < range.last) band.hi = 0.5 * (offset + offsetAt(kk + 1.0)), gap = std::min(gap, offsetAt(kk + 1.0) - offset);
+    const double runOnStep = std::clamp(0.5 * gap, options.toolRadius / 64.0, options.toolRadius / 4.0);
     PlaneSection section = planeSection(surface, out.normal, offset, tolerance);
     out.stats.touchPoints += section.touchPoints.size();
     if (section.curves.empty()) continue;
@@ -186,24 +191,23 @@ ContourPaths contourPaths(const Surface& surface, const ContourOptions& options)
         }
         previous = centre;
       }
-      // With the drop envelope, an open pass runs on past the surface's edge by R along its
-      // end directions: where the planes cross an edge obliquely, the edge between two pass
-      // ends is otherwise cut from one side only (the simulated cut of paper-1 found scallops
-      // of 2.6 H in those wedges). The envelope lifts the overrun clear of the surface.
-      if (options.dropEnvelope && !curve.closed && !pass.moves.empty()) {
-        const Vec3 second = pass.moves.front().end;
-        const Vec3 towardsStart = pass.start - second;
-        if (norm(towardsStart) > 0.0) {
-          const Vec3 before = pass.start + kOverrun * options.toolRadius * normalized(towardsStart);
+      // With the drop envelope, an open pass runs on past the surface's edge while its ball
+      // still finishes points near the edge (envelope.hpp, runOnPastEnd): where the planes
+      // cross an edge obliquely and the surface slopes down to it, the edge between two pass
+      // ends is otherwise left uncut (the simulated cut of paper-1 found scallops of 2.6 H
+      // there with no run-on, 1.7 H with a fixed R / 4).
+      if (distance && !curve.closed && !pass.moves.empty()) {
+        const Vec3 towardsStart = pass.start - pass.moves.front().end;
+        for (const Vec3& c : runOnPastEnd(*distance, pass.start, towardsStart, options.toolRadius,
+                                          band, runOnStep, kRunOnLength * options.toolRadius)) {
           pass.moves.insert(pass.moves.begin(), {MoveKind::line, pass.start, {}, ArcPlane::xy, true});
-          pass.start = before;
+          pass.start = c;
         }
         const Vec3 last = pass.moves.back().end;
         const Vec3 penultimate = pass.moves.size() >= 2 ? pass.moves[pass.moves.size() - 2].end : pass.start;
-        const Vec3 onward = last - penultimate;
-        if (norm(onward) > 0.0) {
-          pass.moves.push_back({MoveKind::line, last + kOverrun * options.toolRadius * normalized(onward), {}, ArcPlane::xy, true});
-        }
+        for (const Vec3& c : runOnPastEnd(*distance, last, last - penultimate, options.toolRadius,
+                                          band, runOnStep, kRunOnLength * options.toolRadius))
+          pass.moves.push_back({MoveKind::line, c, {}, ArcPlane::xy, true});
       }
       if (!pass.moves.empty()) out.path.passes.push_back(std::move(pass));
     }
@@ -217,7 +221,8 @@ ContourPaths contourPaths(const Surface& surface, const ContourOptions& options)
     EnvelopeOptions envelope;
     envelope.depthTolerance = options.depthTolerance;
     envelope.stretchThreshold = options.stretchThreshold;
-    out.path = liftToDropEnvelope(SurfaceDistance(surface), out.path, envelope, out.envelope);
+    envelope.sagTolerance = options.sagTolerance;
+    out.path = liftToDropEnvelope(*distance, out.path, envelope, out.envelope);
     out.stats.centreLength = 0.0;
     for (const ToolPass& pass : out.path.passes) {
       Vec3 at = pass.start;

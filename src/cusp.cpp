@@ -71,13 +71,120 @@ std::vector<CrossGeometry> contactsOf(const Surface& surface, const PlaneSection
 
 // Per sample: the cusp toward the neighbour `delta` away (b flipped for the backward side),
 // or a negative value for a tight concave sample (1 + R kappa <= 0).
+// With centre planes (raster) the plane coordinate W of the centre c = p + R n moves along the
+// offset circle, of radius rho + R: W(l) - W(0) = (1 + R kappa) (a S(l) - b C(l)), so the
+// neighbour's contact is contactDistance(delta / (1 + R kappa)) away.
 double sampleCusp(const CrossGeometry& g, double delta, double radius, bool backward,
-                  bool* overCap) {
-  if (1.0 + radius * g.kappa <= 0.0) return -1.0;
+                  bool* overCap, bool centrePlanes = false) {
+  const double stretch = 1.0 + radius * g.kappa;
+  if (stretch <= 0.0) return -1.0;
   CrossGeometry h = g;
   if (backward) h.b = -h.b;
-  const double l = contactDistance(delta, h, overCap);
-  return std::isfinite(l) ? cuspHeight(l, radius, g.kappa) : kInf;
+  bool cap = false;
+  const double l = contactDistance(centrePlanes ? delta / stretch : delta, h, &cap);
+  if (overCap) *overCap = cap;
+  // Centre planes in a concave sample whose neighbouring plane's centres never reach it
+  // along its offset circle (the circle's W extent is below delta): no neighbour cusp to
+  // speak of, the ball of its own plane and the drop envelope decide there. Counted as tight.
+  if (centrePlanes && cap && g.kappa < 0.0) return -1.0;
+  const double cusp = std::isfinite(l) ? cuspHeight(l, radius, g.kappa) : kInf;
+  // In a concave circle of radius rho > R both balls' centres lie within rho - R of its
+  // centre O, so every point of the circle is within 2 (rho - R) of each ball: the cusp never
+  // exceeds that, however far apart the contacts (near-tight bowls, where the centre barely
+  // moves while the contact sweeps: with centre planes l = delta / (a (1 + R kappa)) is large).
+  return g.kappa < 0.0 ? std::min(cusp, 2.0 * stretch / -g.kappa) : cusp;
+}
+
+// Centre planes (raster, CuspOptions::centrePlanes): the surface sampled on a grid per patch,
+// each sample with the plane coordinate W = N . (p + R n) of the centre that touches it, sorted
+// by W. A pair of planes (w, w + delta) is judged by every sample in its strip.
+struct CentreSample {
+  double w = 0.0;
+  CrossGeometry g;
+};
+
+struct CentreSamples {
+  std::vector<CentreSample> samples;  // by w
+  double leastSine = 1.0;
+
+  // The worst cusp over the samples with W in [w, w + delta], both directions; negative
+  // (none) when the strip holds no sample.
+  double worst(double w, double delta, double radius) const {
+    const auto first = std::lower_bound(samples.begin(), samples.end(), w,
+                                        [](const CentreSample& s, double x) { return s.w < x; });
+    double h = -1.0;
+    for (auto it = first; it != samples.end() && it->w <= w + delta; ++it)
+      for (const bool backward : {false, true}) h = std::max(h, sampleCusp(it->g, delta, radius, backward, nullptr, true));
+    return h;
+  }
+};
+
+// With centre planes the cross direction T lies on the offset surface c = r + R n, and the
+// cusp is that of two balls on its osculating circle along T: of curvature kappa_o(T) =
+// T . S (Id + R S)^-1 T, S the shape operator (dn = S dr, n upward: positive where the
+// surface bends away from the ball), since dc = (Id + R S) dr and dn = S (Id + R S)^-1 dc.
+// The model's circle is the surface's with radius rho = 1 / kappa_o - R, so the effective
+// curvature is kappa_o / (1 - R kappa_o) (its offset circle then has curvature kappa_o).
+// Along a principal direction this is the surface's own normal curvature; elsewhere it differs
+// (paper-1 with R = 1 in: 0.19 against the offset's, and a cusp estimate of 0.93 H where the
+// balls leave 1.23 H). NaN where Id + R S is not positive definite (a concave radius <= R).
+double effectiveCurvature(const BezierPatch& patch, double u, double v, const Vec3& t, const Vec3& n,
+                          double radius) {
+  const PatchDerivatives d = derivativesToSecondOrder(patch, u, v);
+  const double e = dot(d.u, d.u), f = dot(d.u, d.v), g = dot(d.v, d.v);
+  const double det = e * g - f * f;
+  if (!(det > 1e-20 * e * g && det > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  // T = alpha r_u + beta r_v.
+  const double tu = dot(t, d.u), tv = dot(t, d.v);
+  const double alpha = (g * tu - f * tv) / det, beta = (e * tv - f * tu) / det;
+  // S = -I^-1 II in (u, v) coordinates, II = [[L, M], [M, N]] with n.
+  const double l = dot(d.uu, n), m = dot(d.uv, n), nn = dot(d.vv, n);
+  const double s11 = -(g * l - f * m) / det, s12 = -(g * m - f * nn) / det;
+  const double s21 = -(e * m - f * l) / det, s22 = -(e * nn - f * m) / det;
+  // A = Id + R S and its inverse.
+  const double a11 = 1.0 + radius * s11, a12 = radius * s12, a21 = radius * s21, a22 = 1.0 + radius * s22;
+  const double adet = a11 * a22 - a12 * a21;
+  // Id + R S has the eigenvalues 1 + R k_i: both positive iff det > 0 and trace > 0.
+  if (!(adet > 0.0) || !(a11 + a22 > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  // x = S A^-1 (alpha, beta).
+  const double y1 = (a22 * alpha - a12 * beta) / adet, y2 = (-a21 * alpha + a11 * beta) / adet;
+  const double x1 = s11 * y1 + s12 * y2, x2 = s21 * y1 + s22 * y2;
+  // kappa_o = T . (x1 r_u + x2 r_v) = (alpha, beta) I (x1, x2).
+  const double kappaOffset = alpha * (e * x1 + f * x2) + beta * (f * x1 + g * x2);
+  return kappaOffset / (1.0 - radius * kappaOffset);
+}
+
+CentreSamples centreSamples(const Surface& surface, const Vec3& m, double radius, double flatStep) {
+  CentreSamples out;
+  for (std::size_t p = 0; p < surface.patches.size(); ++p) {
+    const BezierPatch& patch = surface.patches[p];
+    // About two samples per flat step-over across the patch's control box, 16 to 128.
+    Vec3 lo = patch.control.front(), hi = lo;
+    for (const Vec3& c : patch.control) {
+      lo = {std::min(lo.x, c.x), std::min(lo.y, c.y), std::min(lo.z, c.z)};
+      hi = {std::max(hi.x, c.x), std::max(hi.y, c.y), std::max(hi.z, c.z)};
+    }
+    const double size = norm(hi - lo);
+    const int grid = static_cast<int>(std::clamp(std::ceil(2.0 * size / flatStep), 16.0, 128.0));
+    for (int i = 0; i <= grid; ++i)
+      for (int j = 0; j <= grid; ++j) {
+        const double u = double(i) / grid, v = double(j) / grid;
+        const Vec3 q = point(patch, u, v);
+        const Vec3 n = upwardNormal(surface, p, u, v);
+        CrossGeometry g = crossGeometry(surface, SectionPoint{q, p, u, v}, m);
+        out.leastSine = std::min(out.leastSine, g.a);
+        if (!(g.a > kTangentSine)) continue;
+        const Vec3 t = (m - g.b * n) / g.a;
+        const double kappa = effectiveCurvature(patch, u, v, t, n, radius);
+        // Tight (a concave radius <= R): the drop envelope lifts the ball there; the sample
+        // is counted as such (1 + R kappa <= 0).
+        g.kappa = std::isfinite(kappa) ? kappa : -2.0 / radius;
+        out.samples.push_back({dot(m, q + radius * n), g});
+      }
+  }
+  std::sort(out.samples.begin(), out.samples.end(),
+            [](const CentreSample& a, const CentreSample& b) { return a.w < b.w; });
+  return out;
 }
 
 void requirePositive(const char* what, double value) {
@@ -189,13 +296,38 @@ CuspStatistics cuspStatistics(const Surface& surface, const Vec3& unitNormal,
   requirePositive("the tool radius", options.toolRadius);
   CuspStatistics out;
   std::vector<double> heights;
+  if (options.centrePlanes) {
+    const double r = options.toolRadius, h = options.scallopHeight;
+    const double flatStep = h > 0.0 && h < r ? 2.0 * std::sqrt(2.0 * r * h - h * h) : r / 4.0;
+    const CentreSamples samples = centreSamples(surface, unitNormal, r, flatStep);
+    for (std::size_t k = 0; k + 1 < planes.size(); ++k) {
+      const double w = planes[k].offset, delta = planes[k + 1].offset - w;
+      if (!(delta > 0.0))
+        throw Error(fmt::format("cuspStatistics: plane offsets must increase, got {} then {}", w,
+                                planes[k + 1].offset));
+      ++out.pairs;
+      const auto first = std::lower_bound(samples.samples.begin(), samples.samples.end(), w,
+                                          [](const CentreSample& s, double x) { return s.w < x; });
+      for (auto it = first; it != samples.samples.end() && it->w <= w + delta; ++it)
+        for (const bool backward : {false, true}) {
+          bool cap = false;
+          const double cusp = sampleCusp(it->g, delta, options.toolRadius, backward, &cap, true);
+          if (cusp < 0.0) {
+            ++out.tooTight;
+            continue;
+          }
+          out.overCap += cap ? 1 : 0;
+          heights.push_back(cusp);
+        }
+    }
+  }
   std::vector<std::vector<CrossGeometry>> contacts;
   contacts.reserve(planes.size());
-  for (const PlaneContacts& plane : planes) {
+  for (const PlaneContacts& plane : options.centrePlanes ? std::vector<PlaneContacts>{} : planes) {
     if (plane.section == nullptr) throw Error("cuspStatistics: a plane without its section");
     contacts.push_back(contactsOf(surface, *plane.section, unitNormal, options.samplesPerPlane));
   }
-  for (std::size_t k = 0; k + 1 < planes.size(); ++k) {
+  for (std::size_t k = 0; k + 1 < contacts.size(); ++k) {
     const double delta = planes[k + 1].offset - planes[k].offset;
     if (!(delta > 0.0))
       throw Error(fmt::format("cuspStatistics: plane offsets must increase, got {} then {}",
@@ -251,7 +383,17 @@ AdaptiveOffsets adaptivePlaneOffsets(const Surface& surface, const Vec3& unitNor
   out.flatStepOver = 2.0 * std::sqrt(2.0 * radius * height - height * height);
   out.floor = options.floorFraction * out.flatStepOver;
   const double ceiling = options.maxStepFactor * out.flatStepOver;
-  const Extent extent = sampleExtent(surface, unitNormal);
+  Extent extent;
+  CentreSamples centres;
+  if (options.centrePlanes) {
+    centres = centreSamples(surface, unitNormal, radius, out.flatStepOver);
+    if (centres.samples.empty()) throw Error("adaptive plane offsets: every sampled normal is parallel to the planes' normal");
+    extent.lo = centres.samples.front().w;
+    extent.hi = centres.samples.back().w;
+    extent.leastSine = centres.leastSine;
+  } else {
+    extent = sampleExtent(surface, unitNormal);
+  }
   out.extentLo = extent.lo;
   out.extentHi = extent.hi;
   if ((extent.hi - extent.lo) / out.floor >= kMaxPlanes)
@@ -267,6 +409,7 @@ AdaptiveOffsets adaptivePlaneOffsets(const Surface& surface, const Vec3& unitNor
   // The pair (w, w + delta)'s worst cusp; the contacts of w + delta are returned for reuse.
   const auto worst = [&](const std::vector<CrossGeometry>& here, double w, double delta,
                          std::vector<CrossGeometry>& next) {
+    if (options.centrePlanes) return std::max(0.0, centres.worst(w, delta, radius));
     double h = 0.0;
     for (const CrossGeometry& g : here) h = std::max(h, sampleCusp(g, delta, radius, false, nullptr));
     next.clear();
@@ -278,8 +421,8 @@ AdaptiveOffsets adaptivePlaneOffsets(const Surface& surface, const Vec3& unitNor
 
   const double first = std::max(out.flatStepOver * extent.leastSine, out.floor);
   double w = extent.lo + 0.5 * first;
-  std::vector<CrossGeometry> here =
-      contactsOf(surface, sectionAt(w), unitNormal, options.samplesPerPlane);
+  std::vector<CrossGeometry> here;
+  if (!options.centrePlanes) here = contactsOf(surface, sectionAt(w), unitNormal, options.samplesPerPlane);
   std::vector<CrossGeometry> trial, accepted;
   for (;;) {
     out.offsets.push_back(w);
@@ -304,7 +447,7 @@ AdaptiveOffsets adaptivePlaneOffsets(const Surface& surface, const Vec3& unitNor
       if (!found) {
         cusp = worst(here, w, out.floor, accepted);
         if (!(cusp <= height)) ++out.floorSteps;
-        if (accepted.empty() && w + out.floor <= extent.hi)
+        if (!options.centrePlanes && accepted.empty() && w + out.floor <= extent.hi)
           accepted = contactsOf(surface, sectionAt(w + out.floor), unitNormal,
                                 options.samplesPerPlane);
         lo = out.floor;
@@ -315,6 +458,15 @@ AdaptiveOffsets adaptivePlaneOffsets(const Surface& surface, const Vec3& unitNor
     out.worstCusp.push_back(cusp);
     w += step;
     here.swap(accepted);
+  }
+  // The last plane as near the far end as the first is to the near one: a last step that
+  // overshoots s_hi would otherwise leave up to a whole step beyond the last plane.
+  const double rest = extent.hi - w;
+  if (rest > 0.5 * first) {
+    const double step = std::max(rest - 0.5 * first, std::min(out.floor, rest));
+    std::vector<CrossGeometry> last;
+    out.worstCusp.push_back(worst(here, w, step, last));
+    out.offsets.push_back(w + step);
   }
   return out;
 }

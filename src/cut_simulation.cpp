@@ -8,6 +8,7 @@
 #include <numbers>
 #include <queue>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -15,7 +16,10 @@
 
 #include "scallop/bernstein.hpp"
 #include "scallop/bezier.hpp"
+#include "scallop/envelope.hpp"
 #include "scallop/error.hpp"
+#include "scallop/gouge.hpp"
+#include "scallop/surface.hpp"
 
 namespace scallop {
 namespace {
@@ -574,9 +578,8 @@ SimulationReport simulateCut(const Surface& surface, const std::vector<SweptMove
   // The comparison.
   const HeightGrid& design = report.design;
   const HeightGrid& stock = report.stock;
-  std::vector<double> scallops;
-  scallops.reserve(design.z.size());
-  double sum = 0.0;
+  std::vector<double> scallopAt(design.z.size(), -1.0);  // -1: no surface
+  std::vector<std::size_t> uncut;
   for (std::size_t j = 0; j < design.rows; ++j) {
     for (std::size_t i = 0; i < design.columns; ++i) {
       const std::size_t index = j * design.columns + i;
@@ -589,11 +592,66 @@ SimulationReport simulateCut(const Surface& surface, const std::vector<SweptMove
         report.maxGougeAt = Vec3{p.x, p.y, d};
       }
       if (d - s > report.gougeTolerance) ++report.gougePoints;
-
-      const double scallop = std::max(0.0, s - d) * report.designNormalZ[index];
+      scallopAt[index] = std::max(0.0, s - d) * report.designNormalZ[index];
+      if (scallopAt[index] > options.scallopHeight) uncut.push_back(index);
+    }
+  }
+  // Which of the points left above H the ball can reach at all (see the contract).
+  report.unreachable.assign(design.z.size(), 0);
+  if (options.classifyReach && !uncut.empty()) {
+    const auto reachStart = std::chrono::steady_clock::now();
+    const std::size_t checks = std::min(uncut.size(), options.maxReachChecks);
+    report.reachChecks = checks;
+    report.reachBudgetExhausted = checks < uncut.size();
+    const SurfaceDistance distance(surface);
+    const double radius = options.toolRadius;
+    const auto classify = [&](std::size_t from, std::size_t to) {
+      DropCutter cutter(distance, radius);
+      for (std::size_t k = from; k < to; ++k) {
+        const std::size_t index = uncut[k];
+        const Vec2 p = design.point(index % design.columns, index / design.columns);
+        const Vec3 q{p.x, p.y, design.z[index]};
+        const ClosestPoint foot = distance.closest(q);
+        Vec3 n = unitNormal(surface.patches[foot.patch], foot.u, foot.v);
+        if (n.z < 0.0) n = -n;
+        const Vec3 c = q + radius * n;
+        const double z = cutter.height(c.x, c.y);
+        if (!std::isfinite(z)) continue;
+        const double lift = std::max(0.0, z - c.z);
+        // |c + lift z - q| - R: how near to q the ball comes from where it would touch it.
+        const double gap = std::sqrt(radius * radius + 2.0 * radius * lift * n.z + lift * lift) - radius;
+        if (gap > options.scallopHeight) report.unreachable[index] = 1;
+      }
+    };
+    const std::size_t threads =
+        std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1, std::max<std::size_t>(1, checks / 256));
+    {
+      std::vector<std::jthread> pool;
+      for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(classify, checks * t / threads, checks * (t + 1) / threads);
+      classify(0, checks / threads);
+    }
+    report.reachSeconds = secondsSince(reachStart);
+  }
+  std::vector<double> scallops;
+  scallops.reserve(design.z.size());
+  double sum = 0.0;
+  for (std::size_t j = 0; j < design.rows; ++j) {
+    for (std::size_t i = 0; i < design.columns; ++i) {
+      const std::size_t index = j * design.columns + i;
+      const double scallop = scallopAt[index];
+      if (scallop < 0.0) continue;
+      const Vec2 p = design.point(i, j);
+      if (report.unreachable[index]) {
+        ++report.unreachablePoints;
+        if (scallop > report.maxUnreachableScallop) {
+          report.maxUnreachableScallop = scallop;
+          report.maxUnreachableAt = Vec3{p.x, p.y, design.z[index]};
+        }
+        continue;
+      }
       if (scallop > report.maxScallop || !report.maxScallopAt) {
         report.maxScallop = scallop;
-        report.maxScallopAt = Vec3{p.x, p.y, d};
+        report.maxScallopAt = Vec3{p.x, p.y, design.z[index]};
       }
       if (scallop > options.scallopHeight) ++report.uncutPoints;
       scallops.push_back(scallop);
@@ -611,6 +669,7 @@ SimulationReport simulateCut(const Surface& surface, const std::vector<SweptMove
   const double cellArea = design.spacing * design.spacing;
   report.gougeArea = static_cast<double>(report.gougePoints) * cellArea;
   report.uncutArea = static_cast<double>(report.uncutPoints) * cellArea;
+  report.unreachableArea = static_cast<double>(report.unreachablePoints) * cellArea;
   report.seconds = secondsSince(start);
   return report;
 }

@@ -6,12 +6,14 @@
 #include <atomic>
 #include <exception>
 #include <numbers>
+#include <optional>
 #include <thread>
 
 #include <fmt/format.h>
 
 #include "scallop/bezier.hpp"
 #include "scallop/error.hpp"
+#include "scallop/surface.hpp"
 
 namespace scallop {
 namespace {
@@ -115,6 +117,14 @@ double ballTop(const Surface& surface, double radius) {
     for (const Vec3& p : patch.control) top = std::max(top, p.z);
   }
   return top + radius * (1.0 + 1e-9) + 1e-9 * std::abs(top);
+}
+
+double bottomOf(const Surface& surface, double radius) {
+  // Below every control point by R and a hair: a centre there is R from the whole surface.
+  double bottom = kInfinity;
+  for (const BezierPatch& patch : surface.patches)
+    for (const Vec3& p : patch.control) bottom = std::min(bottom, p.z);
+  return bottom - (radius * (1.0 + 1e-9) + 1e-9 * std::abs(bottom));
 }
 
 class Lifter {
@@ -265,8 +275,20 @@ PassLift liftPass(const SurfaceDistance& distance, const ToolPass& pass, std::si
 
   // Straight moves from `from` (already lifted) to `to` (lifted): proven, or halved with
   // the midpoint lifted, depth first so the moves come out in order.
+  const double bottom = bottomOf(distance.surface(), radius);
+  const double sagLength = std::sqrt(8.0 * radius * options.sagTolerance);
   auto refineLine = [&](auto&& self, Vec3 from, Vec3 to, double toLift, int halvings) -> void {
     if (lifter.segmentClear(from, to, eps)) {
+      if (options.sagTolerance > 0.0 && halvings < kEnvelopeMaxHalvings &&
+          std::hypot(to.x - from.x, to.y - from.y) > sagLength) {
+        const Vec3 middle = 0.5 * (from + to);
+        const Vec3 onEnvelope = lifter.lift({middle.x, middle.y, bottom});
+        if (onEnvelope.z > bottom && onEnvelope.z < middle.z - options.sagTolerance) {
+          self(self, from, onEnvelope, kInserted, halvings + 1);
+          self(self, onEnvelope, to, toLift, halvings + 1);
+          return;
+        }
+      }
       builder.add(ToolMove{MoveKind::line, to, {}, ArcPlane::xy, true}, toLift);
       return;
     }
@@ -467,6 +489,144 @@ ToolPath liftToDropEnvelope(const SurfaceDistance& distance, const ToolPath& pat
     out.passes.push_back(std::move(lifted.pass));
   }
   return out;
+}
+
+namespace {
+
+
+// Centres along a horizontal line dropped onto the envelope, each judged by the band of the
+// surface point it touches (runOnPastEnd's and dropLineRuns' shared part).
+class BandDropper {
+ public:
+  BandDropper(const SurfaceDistance& distance, double radius, const RunOnBand& band,
+              const EnvelopeOptions& options, const char* what)
+      : distance_(distance), radius_(radius), band_(band) {
+    if (!(radius > 0.0) || !std::isfinite(radius))
+      throw Error(fmt::format("{}: the tool radius must be positive and finite, got {}", what, radius));
+    const Surface& surface = distance.surface();
+    const double eps = options.depthTolerance > 0.0 ? options.depthTolerance : 1e-6 * surfaceScale(surface);
+    if (!(eps < radius))
+      throw Error(fmt::format("{}: the depth tolerance {} must be below the tool radius {}", what, eps, radius));
+    bottom_ = bottomOf(surface, radius);
+    lifter_.emplace(distance, radius, eps, ballTop(surface, radius), options.maxCellsPerProof, proofs_);
+  }
+
+  enum class Verdict { clear, outside, inside };
+  struct Dropped {
+    Vec3 centre;
+    Verdict verdict = Verdict::clear;
+  };
+
+  // The centre over (x, y) on the envelope, and whether it touches nothing (clear), a point
+  // outside the band or one inside.
+  Dropped drop(double x, double y) {
+    Dropped out;
+    out.centre = lifter_->lift({x, y, bottom_});
+    if (!(out.centre.z > bottom_)) return out;  // nothing within R of the vertical line
+    const ClosestPoint contact = distance_.closest(out.centre);
+    Vec3 n = unitNormal(distance_.surface().patches[contact.patch], contact.u, contact.v);
+    if (n.z < 0.0) n = -n;
+    const double w = dot(band_.normal, contact.point + band_.offset * n);
+    out.verdict = w >= band_.lo && w <= band_.hi ? Verdict::inside : Verdict::outside;
+    return out;
+  }
+
+ private:
+  const SurfaceDistance& distance_;
+  double radius_;
+  RunOnBand band_;
+  double bottom_ = 0.0;
+  std::size_t proofs_ = 0;
+  std::optional<Lifter> lifter_;
+};
+
+void checkLine(Vec3 origin, Vec3 direction, double step, double length, const char* what) {
+  if (!(step > 0.0) || !std::isfinite(step) || !(length >= 0.0) || !std::isfinite(length))
+    throw Error(fmt::format("{}: the step ({}) must be positive and the length ({}) finite and >= 0",
+                            what, step, length));
+  if (!isFinite(origin) || !isFinite(direction))
+    throw Error(fmt::format("{}: the points and the direction must be finite", what));
+  if (length / step > 1e7)
+    throw Error(fmt::format("{}: {} steps of {} over {}; more than 10 million", what, length / step, step, length));
+}
+
+}  // namespace
+
+struct DropCutter::State {
+  State(const SurfaceDistance& distance, double radius, double eps)
+      : bottom(bottomOf(distance.surface(), radius)),
+        lifter(distance, radius, eps, ballTop(distance.surface(), radius), 100'000, proofs) {}
+  double bottom;
+  std::size_t proofs = 0;
+  Lifter lifter;
+};
+
+DropCutter::DropCutter(const SurfaceDistance& distance, double radius, const EnvelopeOptions& options) {
+  if (!(radius > 0.0) || !std::isfinite(radius))
+    throw Error(fmt::format("drop cutter: the tool radius must be positive and finite, got {}", radius));
+  const double eps = options.depthTolerance > 0.0 ? options.depthTolerance : 1e-6 * surfaceScale(distance.surface());
+  if (!(eps < radius))
+    throw Error(fmt::format("drop cutter: the depth tolerance {} must be below the tool radius {}", eps, radius));
+  state_ = std::make_unique<State>(distance, radius, eps);
+}
+
+DropCutter::~DropCutter() = default;
+
+double DropCutter::height(double x, double y) {
+  if (!std::isfinite(x) || !std::isfinite(y))
+    throw Error(fmt::format("drop cutter: the point ({}, {}) is not finite", x, y));
+  const Vec3 c = state_->lifter.lift({x, y, state_->bottom});
+  return c.z > state_->bottom ? c.z : -kInfinity;
+}
+
+std::vector<Vec3> runOnPastEnd(const SurfaceDistance& distance, Vec3 end, Vec3 direction,
+                               double radius, const RunOnBand& band, double step, double length,
+                               const EnvelopeOptions& options) {
+  const char* what = "running a pass on";
+  checkLine(end, direction, step, length, what);
+  BandDropper dropper(distance, radius, band, options, what);
+  const double horizontal = std::hypot(direction.x, direction.y);
+  if (!(horizontal > 0.0)) return {};
+  const Vec3 h{direction.x / horizontal, direction.y / horizontal, 0.0};
+  std::vector<Vec3> out;
+  std::size_t keep = 0;  // up to the last vertex inside the band
+  const auto steps = static_cast<std::size_t>(std::floor(length / step));
+  for (std::size_t k = 1; k <= steps; ++k) {
+    const double along = static_cast<double>(k) * step;
+    const BandDropper::Dropped c = dropper.drop(end.x + along * h.x, end.y + along * h.y);
+    if (c.verdict == BandDropper::Verdict::clear) break;
+    out.push_back(c.centre);
+    if (c.verdict == BandDropper::Verdict::inside) keep = out.size();
+  }
+  out.resize(keep);
+  return out;
+}
+
+std::vector<std::vector<Vec3>> dropLineRuns(const SurfaceDistance& distance, Vec3 origin,
+                                            Vec3 direction, double from, double to, double radius,
+                                            const RunOnBand& band, double step,
+                                            const EnvelopeOptions& options) {
+  const char* what = "dropping a line onto the envelope";
+  checkLine(origin, direction, step, to - from, what);
+  BandDropper dropper(distance, radius, band, options, what);
+  const double horizontal = std::hypot(direction.x, direction.y);
+  if (!(horizontal > 0.0)) throw Error(fmt::format("{}: the direction is vertical", what));
+  const Vec3 h{direction.x / horizontal, direction.y / horizontal, 0.0};
+  std::vector<std::vector<Vec3>> runs;
+  std::vector<Vec3> run;
+  const auto steps = static_cast<std::size_t>(std::floor((to - from) / step));
+  for (std::size_t k = 0; k <= steps; ++k) {
+    const double t = from + static_cast<double>(k) * step;
+    const BandDropper::Dropped c = dropper.drop(origin.x + t * h.x, origin.y + t * h.y);
+    if (c.verdict == BandDropper::Verdict::inside) {
+      run.push_back(c.centre);
+      continue;
+    }
+    if (run.size() >= 2) runs.push_back(std::move(run));
+    run.clear();
+  }
+  if (run.size() >= 2) runs.push_back(std::move(run));
+  return runs;
 }
 
 }  // namespace scallop

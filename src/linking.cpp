@@ -4,11 +4,13 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
+#include <optional>
 #include <utility>
 #include <vector>
 
 #include <fmt/format.h>
 
+#include "scallop/envelope.hpp"
 #include "scallop/error.hpp"
 #include "scallop/gouge.hpp"
 #include "clearance.hpp"
@@ -19,6 +21,8 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 // Sphere-tracing steps a direct link's proof may take (see below).
 constexpr int kDirectLinkMaxSteps = 256;
+// Moves a link over the drop envelope may have before a retract is preferred.
+constexpr std::size_t kEnvelopeLinkMaxMoves = 2'000;
 
 double resolved(const char* name, double value, double fallback) {
   if (!(std::isfinite(value) && value >= 0.0))
@@ -201,7 +205,30 @@ LinkedPath linkToolPath(const Surface& surface, const ToolPath& path, const Link
     return !(c.z < top) ||
            detail::segmentClears(distance, c, {c.x, c.y, top}, radius - allowed, radius, minStep);
   };
+  // [e, s] lifted to the drop envelope, when that changes neither end and proves every move.
+  const auto envelopeLink = [&](Vec3 e, Vec3 s) -> std::optional<std::vector<ToolMove>> {
+    ToolPath link;
+    link.units = surface.units;
+    link.toolRadius = radius;
+    link.passes.push_back(ToolPass{e, {ToolMove{MoveKind::line, s, {}, ArcPlane::xy, true}}, false, {}});
+    EnvelopeOptions envelope;
+    envelope.depthTolerance = epsilon;
+    envelope.threads = 1;
+    envelope.maxMoves = kEnvelopeLinkMaxMoves;
+    EnvelopeReport report;
+    ToolPath lifted;
+    try {
+      lifted = liftToDropEnvelope(distance, link, envelope, report);
+    } catch (const Error&) {
+      return std::nullopt;  // over its budget: a retract instead
+    }
+    const ToolPass& pass = lifted.passes.front();
+    if (report.unprovenMoves > 0 || !(pass.start == e) || pass.moves.empty() || !(passEnd(pass) == s))
+      return std::nullopt;
+    return pass.moves;
+  };
   std::vector<ToolPass>& passes = out.path.passes;
+  out.linkMoves.assign(passes.size(), 0);
   for (std::size_t i = 0; i < passes.size(); ++i) {
     ToolPass& pass = passes[i];
     if (i > 0 && !pass.retractBefore) continue;  // the strategy's own link
@@ -229,6 +256,22 @@ LinkedPath linkToolPath(const Surface& surface, const ToolPath& path, const Link
       ++out.stats.directLinks;
       out.stats.directLinkLength += length;
       continue;
+    }
+    // The straight feed dips into the surface between two ends that touch it (two balls
+    // beside an edge, on a crest): the feed over the drop envelope instead, every move
+    // proven to cut no deeper than epsilon (envelope.hpp).
+    if (length <= out.stats.directLinkMax) {
+      if (std::optional<std::vector<ToolMove>> hugging = envelopeLink(e, s)) {
+        Vec3 at = e;
+        for (const ToolMove& move : *hugging) out.stats.directLinkLength += norm(move.end - at), at = move.end;
+        pass.moves.insert(pass.moves.begin(), hugging->begin(), hugging->end());
+        pass.start = e;
+        out.linkMoves[i] = hugging->size();
+        pass.retractBefore = false;
+        ++out.stats.directLinks;
+        ++out.stats.envelopeLinks;
+        continue;
+      }
     }
     const double top = heights.above({e.x, e.y}, {s.x, s.y}, radius) + radius;
     const double height = std::max({e.z, s.z, top + out.stats.clearance});

@@ -192,6 +192,8 @@ std::string pathsToJson(const PathsReport& report, const ToolPath& path) {
     verification["scallop_p99"] = v.scallopP99;
     verification["mean_scallop"] = v.meanScallop;
     verification["uncut_area"] = v.uncutArea;
+    verification["unreachable_area"] = v.unreachableArea;
+    verification["unreachable_max_left"] = v.maxUnreachableLeft;
     verification["rapids_cutting"] = v.rapidsCutting;
     verification["seconds"] = v.seconds;
     document["verification"] = std::move(verification);
@@ -227,6 +229,7 @@ std::string pathsToJson(const PathsReport& report, const ToolPath& path) {
     linking["reversed_passes"] = l.reversedPasses;
     linking["rotated_loops"] = l.rotatedLoops;
     linking["direct_links"] = l.directLinks;
+    linking["envelope_links"] = l.envelopeLinks;
     linking["local_retracts"] = l.localRetracts;
     linking["unproven_links"] = l.unprovenLinks;
     linking["strategy_links"] = l.strategyLinks;
@@ -269,9 +272,11 @@ std::string pathsToJson(const PathsReport& report, const ToolPath& path) {
     for (const ToolMove& move : pass.moves) ok = ok && finite(move.end) && finite(move.center);
     if (!ok) throw Error(fmt::format("cannot write the tool path: pass {} has a position that is not finite", i));
   }
-  for (const ToolPass& pass : path.passes) {
+  for (std::size_t i = 0; i < path.passes.size(); ++i) {
+    const ToolPass& pass = path.passes[i];
     Json p;
     p["retract_before"] = pass.retractBefore;
+    if (i < report.linkMoves.size() && report.linkMoves[i] > 0) p["link_moves"] = report.linkMoves[i];
     if (pass.retract) p["retract"] = {{"height", pass.retract->height}, {"plunge", pass.retract->plunge}};
     p["start"] = vec(pass.start);
     Json moves = Json::array();

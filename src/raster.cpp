@@ -24,6 +24,7 @@ using detail::segmentClears;
 constexpr double kPi = std::numbers::pi;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
+
 void requirePositive(const char* what, double value) {
   if (!(value > 0.0) || !std::isfinite(value))
     throw Error(fmt::format("{} must be a positive number, got {}", what, value));
@@ -481,6 +482,7 @@ void liftRasterPaths(const SurfaceDistance& distance, const RasterOptions& optio
   EnvelopeOptions envelope;
   envelope.depthTolerance = options.depthTolerance;
   envelope.stretchThreshold = options.stretchThreshold;
+  envelope.sagTolerance = options.sagTolerance;
   std::vector<std::vector<std::size_t>> moveMap;
   out.path = liftToDropEnvelope(distance, out.path, envelope, out.envelope, &moveMap);
   out.stats.centreLength = 0.0;
@@ -567,39 +569,124 @@ RasterPaths rasterPaths(const Surface& surface, const RasterOptions& options) {
     return heights.above({x, y}, {x, y}, radius) + radius;
   };
   const auto line = [](Vec3 end) { return ToolMove{MoveKind::line, end, {}, ArcPlane::xy, true}; };
-  for (double kk = range.first; kk <= range.last; kk += 1.0) {
-    const double w =
-        explicitOffsets ? options.planeOffsets[static_cast<std::size_t>(kk)] : kk * out.spacing;
+  const auto offsetAt = [&](double kk) {
+    return explicitOffsets ? options.planeOffsets[static_cast<std::size_t>(kk)] : kk * out.spacing;
+  };
+  // The footprint's extent along d (control points), for the drop lines.
+  double footLo = kInf, footHi = -kInf;
+  for (const BezierPatch& patch : surface.patches)
+    for (const Vec3& p : patch.control) footLo = std::min(footLo, dot(frame.d, p)), footHi = std::max(footHi, dot(frame.d, p));
+
+  // One plane's passes, in increasing s, not yet reversed, run on past their ends (with the
+  // drop envelope): from the scallop hulls of its chains, or, where its section gives none
+  // and `dropLine`, from the drop envelope along the line (envelope.hpp, dropLineRuns).
+  struct PlaneBuild {
+    RasterSection plane;
+    std::vector<ToolPass> passes;
+    std::size_t components = 0;
+    double contactLength = 0.0;
+    bool visible = false;
+  };
+  const auto buildPlane = [&](double w, long long k, const RunOnBand& band, double runOnStep,
+                              bool dropLine) {
+    PlaneBuild b;
     PlaneSection section = planeSection(surface, frame.e, w, tolerance);
     out.stats.touchPoints += section.touchPoints.size();
-    RasterSection plane;
-    plane.offset = w;
-    plane.k = static_cast<long long>(kk);
+    b.plane.offset = w;
+    b.plane.k = k;
     if (options.dropEnvelope) {
       // Not a graph here: the part a ball from above sees (the error names where otherwise).
       try {
-        plane.chains = planeChains(section, frame, w, radius, tau);
+        b.plane.chains = planeChains(section, frame, w, radius, tau);
       } catch (const Error&) {
-        plane.chains = visibleChains(section, frame, radius);
-        ++out.visibleFromAbovePlanes;
+        b.plane.chains = visibleChains(section, frame, radius);
+        b.visible = true;
       }
     } else {
-      plane.chains = planeChains(section, frame, w, radius, tau);
+      b.plane.chains = planeChains(section, frame, w, radius, tau);
     }
-    if (plane.chains.empty()) continue;
+    b.components = section.components;
+    for (const SectionCurve& curve : section.curves) b.contactLength += curveLength(curve);
+    for (RasterChain& chain : b.plane.chains) {
+      chain.hull = scallopHull(chain.chain, radius);
+      ToolPass pass = passFromHull(chain.hull, frame, w, arcTolerance);
+      if (options.dropEnvelope) {
+        // The pass runs on past both ends while its ball still finishes its own band of the
+        // surface (envelope.hpp, runOnPastEnd).
+        for (const Vec3& c : runOnPastEnd(distance, passEnd(pass), frame.d, radius, band, runOnStep, kRunOnLength * radius))
+          pass.moves.push_back(line(c));
+        for (const Vec3& c : runOnPastEnd(distance, pass.start, -frame.d, radius, band, runOnStep, kRunOnLength * radius)) {
+          pass.moves.insert(pass.moves.begin(), line(pass.start));
+          pass.start = c;
+        }
+      }
+      b.passes.push_back(std::move(pass));
+    }
+    if (b.plane.chains.empty() && dropLine && options.dropEnvelope) {
+      b.plane.dropLine = true;
+      for (std::vector<Vec3>& run : dropLineRuns(distance, w * frame.e, frame.d, footLo - radius, footHi + radius,
+                                                 radius, band, runOnStep)) {
+        ToolPass pass;
+        pass.start = run.front();
+        for (std::size_t v = 1; v < run.size(); ++v) pass.moves.push_back(line(run[v]));
+        b.passes.push_back(std::move(pass));
+      }
+    }
+    b.plane.section = std::move(section);
+    return b;
+  };
+  // Run-on steps of half the gap to the nearest plane: a chord of the envelope (radius of
+  // curvature >= R about an edge) then sags by at most gap^2 / (32 R), H / 4 sin^2(alpha) at
+  // the flat spacing.
+  const auto runOnStepFor = [&](double gap) { return std::clamp(0.5 * gap, radius / 64.0, radius / 4.0); };
+
+  // With the drop envelope, planes beyond the outermost ones, at the outermost gap, while
+  // their balls still finish points of the surface that no given plane's ball does: a raster
+  // ball's contacts are shifted across its plane by R (e . n) where the surface slopes across
+  // it, so the points near the surface's extreme in e are reached only from planes beyond
+  // (the simulated cut of paper-1 found an untouched corner at 9.6 H). At most R / gap + 2
+  // each side.
+  std::vector<PlaneBuild> below, above;
+  const std::size_t planeCount = static_cast<std::size_t>(range.last - range.first + 1.0);
+  if (options.dropEnvelope) {
+    const double fallbackGap = out.spacing > 0.0 ? out.spacing : radius / 4.0;
+    const double gapLo = planeCount >= 2 ? offsetAt(range.first + 1.0) - offsetAt(range.first) : fallbackGap;
+    const double gapHi = planeCount >= 2 ? offsetAt(range.last) - offsetAt(range.last - 1.0) : fallbackGap;
+    for (const int side : {-1, 1}) {
+      const double gap = side < 0 ? gapLo : gapHi;
+      const double edge = offsetAt(side < 0 ? range.first : range.last);
+      const long long edgeK = static_cast<long long>(side < 0 ? range.first : range.last);
+      const auto count = static_cast<long long>(std::ceil(radius / gap)) + 2;
+      for (long long j = 1; j <= count; ++j) {
+        const double w = edge + static_cast<double>(side * j) * gap;
+        RunOnBand band{frame.e, radius};
+        (side < 0 ? band.hi : band.lo) = w - 0.5 * side * gap;
+        PlaneBuild b = buildPlane(w, edgeK + side * j, band, runOnStepFor(gap), true);
+        if (b.passes.empty()) break;
+        (side < 0 ? below : above).push_back(std::move(b));
+      }
+    }
+  }
+  std::vector<double> outerOffsets;  // every plane's w, in increasing order
+  for (auto b = below.rbegin(); b != below.rend(); ++b) outerOffsets.push_back(b->plane.offset);
+  for (double kk = range.first; kk <= range.last; kk += 1.0) outerOffsets.push_back(offsetAt(kk));
+  for (const PlaneBuild& b : above) outerOffsets.push_back(b.plane.offset);
+
+  // A plane's passes into the path: zigzag, ways on and off, links from the previous plane.
+  const auto appendPlane = [&](PlaneBuild&& b) {
+    RasterSection& plane = b.plane;
+    if (b.passes.empty()) return;
     plane.reversed = out.sections.size() % 2 == 1;
     ++out.stats.planes;
-    out.stats.components += section.components;
-    for (const SectionCurve& curve : section.curves) out.stats.contactLength += curveLength(curve);
-
+    out.visibleFromAbovePlanes += b.visible ? 1 : 0;
+    out.stats.components += b.components;
+    out.stats.contactLength += b.contactLength;
     const std::size_t index = out.sections.size();
-    const std::size_t n = plane.chains.size();
+    const std::size_t n = b.passes.size();
     for (std::size_t i = 0; i < n; ++i) {
       const std::size_t c = plane.reversed ? n - 1 - i : i;
-      RasterChain& chain = plane.chains[c];
-      chain.hull = scallopHull(chain.chain, radius);
-      out.stats.centreLength += pathLength(chain.hull.toolpath);
-      ToolPass pass = passFromHull(chain.hull, frame, w, arcTolerance);
+      ToolPass pass = std::move(b.passes[c]);
+      if (!plane.dropLine) out.stats.centreLength += pathLength(plane.chains[c].hull.toolpath);
       if (plane.reversed) pass = reversedPass(pass);
       RasterPass info{index, c, plane.reversed, 0, 0.0, 0, 0};
       // Ways on and off: the entry is an exit run backwards.
@@ -643,13 +730,24 @@ RasterPaths rasterPaths(const Surface& surface, const RasterOptions& options) {
       } else {
         pass.retractBefore = true;
       }
-      chain.pass = out.path.passes.size();
+      if (!plane.dropLine) plane.chains[c].pass = out.path.passes.size();
       out.path.passes.push_back(std::move(pass));
       out.passes.push_back(info);
     }
-    plane.section = std::move(section);
     out.sections.push_back(std::move(plane));
+  };
+
+  for (auto b = below.rbegin(); b != below.rend(); ++b) appendPlane(std::move(*b));
+  for (double kk = range.first; kk <= range.last; kk += 1.0) {
+    const std::size_t at = below.size() + static_cast<std::size_t>(kk - range.first);
+    const double w = outerOffsets[at];
+    RunOnBand band{frame.e, radius};
+    double gap = 4.0 * radius;
+    if (at > 0) band.lo = 0.5 * (outerOffsets[at - 1] + w), gap = std::min(gap, w - outerOffsets[at - 1]);
+    if (at + 1 < outerOffsets.size()) band.hi = 0.5 * (w + outerOffsets[at + 1]), gap = std::min(gap, outerOffsets[at + 1] - w);
+    appendPlane(buildPlane(w, static_cast<long long>(kk), band, runOnStepFor(gap), true));
   }
+  for (PlaneBuild& b : above) appendPlane(std::move(b));
   if (out.sections.empty())
     throw Error(fmt::format(
         "no plane e . r = k * {} with e = ({}, {}, 0) cuts the surface (e . r spans [{}, {}])",

@@ -50,13 +50,16 @@ std::string escaped(const std::string& text) {
   return out;
 }
 
-// The colour index of a block: 0..9 scallop, 10..14 gouge, 15 no surface.
+// The colour index of a block: 0..9 scallop, 10..14 gouge, 15 no surface, 16 beyond the
+// tool's reach (cut_simulation.hpp's Reach).
 constexpr int kNoSurfaceIndex = 15;
+constexpr int kUnreachableIndex = 16;
+constexpr const char* kUnreachable = "#f781bf";
 
 const char* colourOf(int index) {
   if (index < 10) return kScallopColours[static_cast<std::size_t>(index)];
   if (index < 15) return kGougeColours[static_cast<std::size_t>(index - 10)];
-  return kNoSurface;
+  return index == kUnreachableIndex ? kUnreachable : kNoSurface;
 }
 
 }  // namespace
@@ -103,6 +106,14 @@ std::string verifyToJson(const SimulationReport& r, const VerifySources& sources
   scallop["uncut_points"] = r.uncutPoints;
   scallop["uncut_area"] = r.uncutArea;
   document["scallop"] = scallop;
+  Json reach;
+  reach["unreachable_points"] = r.unreachablePoints;
+  reach["unreachable_area"] = r.unreachableArea;
+  reach["max_material_left"] = r.maxUnreachableScallop;
+  reach["at"] = pointJson(r.maxUnreachableAt);
+  reach["points_classified"] = r.reachChecks;
+  reach["budget_exhausted"] = r.reachBudgetExhausted;
+  document["beyond_reach"] = reach;
   Json seconds;
   seconds["design"] = r.designSeconds;
   seconds["sweep"] = r.sweepSeconds;
@@ -135,18 +146,25 @@ std::string verifySvg(const SimulationReport& r, const VerifySources& sources) {
   for (std::size_t b = 0; b < by; ++b) {
     for (std::size_t a = 0; a < bx; ++a) {
       double worstGouge = -1.0, worstScallop = -1.0;
+      bool unreachable = false;
       for (std::size_t j = b * block; j < std::min(design.rows, (b + 1) * block); ++j) {
         for (std::size_t i = a * block; i < std::min(design.columns, (a + 1) * block); ++i) {
           const std::size_t k = j * design.columns + i;
           if (design.z[k] == -std::numeric_limits<double>::infinity()) continue;
           const double difference = stock.z[k] - design.z[k];
           if (-difference > r.gougeTolerance) worstGouge = std::max(worstGouge, -difference);
+          if (k < r.unreachable.size() && r.unreachable[k]) {
+            unreachable = true;
+            continue;
+          }
           worstScallop = std::max(worstScallop, std::max(0.0, difference) * r.designNormalZ[k]);
         }
       }
       int index = kNoSurfaceIndex;
       if (worstGouge >= 0.0) {
         index = 10 + std::clamp(static_cast<int>(std::log(std::max(worstGouge, floorGouge) / floorGouge) / gougeSpan * 5.0), 0, 4);
+      } else if (unreachable) {
+        index = kUnreachableIndex;
       } else if (worstScallop >= 0.0) {
         index = std::clamp(static_cast<int>(worstScallop / (2.0 * h) * 10.0), 0, 9);
       }
@@ -155,12 +173,12 @@ std::string verifySvg(const SimulationReport& r, const VerifySources& sources) {
   }
 
   // Page layout: the map scaled to fit 600 x 600 px, bars on the right.
-  constexpr double kMargin = 40.0, kTop = 78.0, kMapSize = 600.0, kBarX = 60.0;
+  constexpr double kMargin = 40.0, kTop = 96.0, kMapSize = 600.0, kBarX = 60.0;
   const double width = static_cast<double>(design.columns) * design.spacing;
   const double height = static_cast<double>(design.rows) * design.spacing;
   const double scale = kMapSize / std::max(width, height);
   const double mapW = width * scale, mapH = height * scale;
-  const double pageW = std::max(kMargin + mapW + kBarX + 200.0, 900.0), pageH = kTop + mapH + 60.0;
+  const double pageW = std::max(kMargin + mapW + kBarX + 200.0, 1000.0), pageH = kTop + mapH + 60.0;
   const double cell = static_cast<double>(block) * design.spacing * scale;
   // Block (a, b) covers x from x0 - d/2 + a block d; rows drawn top down (y up).
   auto pageX = [&](double x) { return kMargin + (x - (design.x0 - 0.5 * design.spacing)) * scale; };
@@ -184,10 +202,13 @@ std::string verifySvg(const SimulationReport& r, const VerifySources& sources) {
       "{}&#178;</text>\n",
       px(kMargin), lengthLabel(r.maxScallop), units, lengthLabel(r.scallopP99), units, lengthLabel(r.meanScallop), units,
       lengthLabel(r.uncutArea), units);
+  out += fmt::format(
+      "<text x=\"{}\" y=\"78\">beyond the ball's reach (left out of the scallop figures): {} {}&#178;, up to {} {} left</text>\n",
+      px(kMargin), lengthLabel(r.unreachableArea), units, lengthLabel(r.maxUnreachableScallop), units);
 
   // One path per colour, in block units (a transform scales them to the page): each run of
   // blocks of one colour in a row is "M a b h n v 1 h -n z", some 15 bytes.
-  std::array<std::string, 16> runs;
+  std::array<std::string, 17> runs;
   for (std::size_t b = 0; b < by; ++b) {
     const std::size_t top = by - 1 - b;  // y up
     std::size_t a = 0;
@@ -259,12 +280,17 @@ std::string verifySvg(const SimulationReport& r, const VerifySources& sources) {
   out += fmt::format("<rect x=\"{}\" y=\"{}\" width=\"20\" height=\"{}\" fill=\"{}\"/>\n", px(barX), px(noneY),
                      px(step), kNoSurface);
   out += fmt::format("<text x=\"{}\" y=\"{}\">no surface</text>\n", px(barX + 26.0), px(noneY + 16.0));
-  out += fmt::format("<text x=\"{}\" y=\"{}\">grid {} x {} points,</text>\n", px(barX), px(noneY + 52.0),
+  const double reachY = noneY + step + 8.0;
+  out += fmt::format("<rect x=\"{}\" y=\"{}\" width=\"20\" height=\"{}\" fill=\"{}\"/>\n", px(barX), px(reachY),
+                     px(step), kUnreachable);
+  out += fmt::format("<text x=\"{}\" y=\"{}\">beyond the ball's reach</text>\n", px(barX + 26.0), px(reachY + 16.0));
+  const double gridY = reachY + step;
+  out += fmt::format("<text x=\"{}\" y=\"{}\">grid {} x {} points,</text>\n", px(barX), px(gridY + 36.0),
                      design.columns, design.rows);
-  out += fmt::format("<text x=\"{}\" y=\"{}\">spacing {} {}</text>\n", px(barX), px(noneY + 70.0),
+  out += fmt::format("<text x=\"{}\" y=\"{}\">spacing {} {}</text>\n", px(barX), px(gridY + 54.0),
                      lengthLabel(design.spacing), units);
   if (block > 1)
-    out += fmt::format("<text x=\"{}\" y=\"{}\">{} x {} points per square</text>\n", px(barX), px(noneY + 88.0),
+    out += fmt::format("<text x=\"{}\" y=\"{}\">{} x {} points per square</text>\n", px(barX), px(gridY + 72.0),
                        block, block);
   out += "</svg>\n";
   return out;

@@ -284,7 +284,10 @@ void checkAdaptive(const Surface& s, const Vec3& n, const scallop::CuspOptions& 
     }
     EXPECT_LE(a.worstCusp[k], options.scallopHeight) << what << " step " << k;
     const bool ceiling = step >= options.maxStepFactor * a.flatStepOver * (1.0 - 1e-9);
-    if (!ceiling && a.worstCusp[k] < 0.5 * options.scallopHeight) ++low;
+    // The last step only brings the last plane as near the far end as the first is to the
+    // near one (see the contract): it may be narrower than the cusp needs.
+    const bool last = k + 2 == a.offsets.size();
+    if (!ceiling && !last && a.worstCusp[k] < 0.5 * options.scallopHeight) ++low;
   }
   EXPECT_EQ(low, 0u) << what << ": steps narrower than needed";
   EXPECT_LE(floors, a.floorSteps + 1) << what;

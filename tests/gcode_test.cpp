@@ -463,6 +463,11 @@ std::vector<Motion> expectedCuts(const ToolPath& path, const GcodeOptions& optio
     } else {
       link.start = previous;
       link.feedRate = options.feedRate;
+      // A feed that rounds to nothing (a pass starting where the last ended) is left out.
+      const double scale = path.units == Units::inch ? 1e5 : 1e4;
+      const auto same = [&](double a, double b) { return std::llround(a * scale) == std::llround(b * scale); };
+      if (same(link.start.x, start.x) && same(link.start.y, start.y) && same(link.start.z, start.z))
+        link.kind = Motion::Kind::traverse;
     }
     if (link.kind == Motion::Kind::feed) cuts.push_back(link);
     Vec3 current = start;

@@ -117,6 +117,16 @@ bool sameArc(const ToolMove& a, const ToolMove& b, bool flipped) {
   return ::testing::AssertionFailure() << "no rotation of the input matches";
 }
 
+// Output pass i without the moves the linker put in front of it (an envelope link).
+ToolPass withoutLink(const LinkedPath& linked, std::size_t i) {
+  ToolPass pass = linked.path.passes[i];
+  const std::size_t k = i < linked.linkMoves.size() ? linked.linkMoves[i] : 0;
+  if (k == 0) return pass;
+  pass.start = pass.moves[k - 1].end;
+  pass.moves.erase(pass.moves.begin(), pass.moves.begin() + static_cast<std::ptrdiff_t>(k));
+  return pass;
+}
+
 struct JudgeResult {
   double worstExcess = -1e300;  // max over samples of (limit - reference distance)
   std::size_t samples = 0;
@@ -164,7 +174,17 @@ JudgeResult judgeLinks(const Surface& surface, const ToolPath& input, const Link
     const bool strategyLink = !input.passes[linked.origin[i]].retractBefore;
     if (strategyLink) continue;  // the strategy's own, left alone
     const Vec3 e = endOf(passes[i - 1]);
-    if (!pass.retractBefore) {
+    const std::size_t linkMoves = linked.linkMoves.at(i);
+    if (linkMoves > 0) {
+      // Over the drop envelope: every move within epsilon of the surface at most.
+      EXPECT_FALSE(pass.retractBefore) << where;
+      EXPECT_TRUE(pass.start == e) << where << " does not start at the previous end";
+      Vec3 at = s;
+      for (std::size_t m = 0; m < linkMoves; ++m) {
+        sampleSegment(surface, at, pass.moves[m].end, radius - epsilon, step, where + " (over the envelope)", result);
+        at = pass.moves[m].end;
+      }
+    } else if (!pass.retractBefore) {
       sampleSegment(surface, e, s, radius - std::max(allowance(e), allowance(s)), step,
                     where + " (direct)", result);
     } else if (pass.retract) {
@@ -195,7 +215,7 @@ void expectLinkedWell(const Surface& surface, const ToolPath& input, const LinkO
   std::size_t reversedCount = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const ToolPass& in = input.passes[linked.origin[i]];
-    EXPECT_TRUE(samePass(in, linked.path.passes[i], linked.reversed[i])) << "pass " << i;
+    EXPECT_TRUE(samePass(in, withoutLink(linked, i), linked.reversed[i])) << "pass " << i;
     if (linked.reversed[i]) ++reversedCount;
     if (options.direction == PassDirection::keep) {
       EXPECT_FALSE(linked.reversed[i]);
@@ -368,12 +388,17 @@ TEST(Linking, JudgeCatchesBadLinks) {
   LinkedPath linked = linkToolPath(surface, path);
   LinkedPath lowered = linked;
   std::size_t changed = 0;
-  for (ToolPass& pass : lowered.path.passes)
-    if (pass.retract && &pass != &lowered.path.passes.front()) {
-      pass.retract->height = pass.start.z;
-      pass.retract->plunge = 0.0;
-      ++changed;
-    }
+  // Every link after the first made a local retract at the pass's start height (the linker
+  // made none here: its feeds over the envelope serve every link).
+  for (std::size_t i = 1; i < lowered.path.passes.size(); ++i) {
+    ToolPass pass = withoutLink(lowered, i);
+    if (!path.passes[lowered.origin[i]].retractBefore) continue;  // the strategy's own link
+    pass.retractBefore = true;
+    pass.retract = LocalRetract{pass.start.z, 0.0};
+    lowered.path.passes[i] = pass;
+    lowered.linkMoves[i] = 0;
+    ++changed;
+  }
   ASSERT_GT(changed, 0u);
   const JudgeResult low = judgeLinks(surface, path, lowered);
   EXPECT_GT(low.worstExcess, 1e-3) << low.where;
@@ -381,6 +406,15 @@ TEST(Linking, JudgeCatchesBadLinks) {
   // The last pass fed straight from the first pass's end: across the whole part.
   std::swap(through.path.passes[1], through.path.passes.back());
   std::swap(through.origin[1], through.origin.back());
+  std::swap(through.linkMoves[1], through.linkMoves.back());
+  // The other links over the envelope now lead from the wrong ends: safe-height retracts.
+  for (std::size_t i = 1; i < through.path.passes.size(); ++i) {
+    if (through.linkMoves[i] == 0) continue;
+    through.path.passes[i] = withoutLink(through, i);
+    through.path.passes[i].retractBefore = true;
+    through.path.passes[i].retract.reset();
+    through.linkMoves[i] = 0;
+  }
   through.path.passes[1].retractBefore = false;
   through.path.passes[1].retract.reset();
   const JudgeResult cut = judgeLinks(surface, path, through);

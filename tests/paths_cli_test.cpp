@@ -81,16 +81,22 @@ TEST_F(PathsCli, PlanWithNoArgumentsWritesTheWholeFolder) {
   EXPECT_GT(stats["planes"].get<int>(), 50);
   EXPECT_EQ(stats["passes"].get<std::size_t>(), report["passes"].size());
   EXPECT_FALSE(stats.contains("link_length"));  // raster only
-  // The centre length is the sum of the passes' line lengths.
+  // The centre length is the sum of the passes' line lengths, the linker's feeds over the
+  // envelope ("link_moves" leading moves) left out.
   double length = 0.0;
+  std::size_t envelopeLinks = 0;
   for (const auto& pass : report["passes"]) {
     std::vector<double> at = pass["start"].get<std::vector<double>>();
+    const std::size_t skip = pass.value("link_moves", std::size_t{0});
+    envelopeLinks += skip > 0 ? 1 : 0;
+    std::size_t k = 0;
     for (const auto& move : pass["moves"]) {
       const std::vector<double> end = move["line"].get<std::vector<double>>();
-      length += std::hypot(end[0] - at[0], end[1] - at[1], end[2] - at[2]);
+      if (k++ >= skip) length += std::hypot(end[0] - at[0], end[1] - at[1], end[2] - at[2]);
       at = end;
     }
   }
+  EXPECT_EQ(envelopeLinks, report["linking"]["envelope_links"].get<std::size_t>());
   EXPECT_NEAR(length, stats["centre_length"].get<double>(), 1e-9 * length);
   const std::string gcode = readFile(workDir_ / "scallop-out" / "toolpath.ngc");
   EXPECT_NE(gcode.find("G20"), std::string::npos);

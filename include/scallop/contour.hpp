@@ -64,6 +64,8 @@ struct ContourOptions {
   double depthTolerance = 0.0;  /// Lifts above this are reported as stretches the ball cannot follow (>= 0); 0 means
   /// the envelope's default (10 eps). The CLI passes the scallop height.
   double stretchThreshold = 0.0;
+  /// The drop envelope's sag tolerance (envelope.hpp; >= 0, 0: off). The CLI passes H / 4.
+  double sagTolerance = 0.0;
   /// Explicit plane offsets (strictly increasing, finite, at most kMaxPlanes), used instead
   /// of k Delta when non-empty: the planes N . r = planeOffsets[k] (cusp.hpp's
   /// adaptivePlaneOffsets). `spacing` is then only reported (it may be 0).

@@ -72,9 +72,25 @@
 //         with `bisectionSteps` sections. floor = floorFraction * l_H: where even the floor
 //         fails (near tangency: a tends to 0 and l = Delta / a grows without bound; at a
 //         touch point; where the balls cannot meet), the step is the floor and `floorSteps`
-//         counts it, so the offsets never stall. Stops when w_{k+1} > s_hi. A part of the
+//         counts it, so the offsets never stall. Stops when w_{k+1} > s_hi; then, if s_hi - w_k >
+//         firstStep / 2, one more plane at w_k + max(s_hi - w_k - firstStep / 2, min(floor,
+//         s_hi - w_k)), so the last plane lies as near s_hi as the first lies to s_lo. A part of the
 //         surface that lies between two planes and that neither plane's section reaches is
 //         not seen by the estimate (as with a constant spacing).
+// Centre planes (CuspOptions::centrePlanes, raster): a raster ball's centre c lies in its
+//         plane, and it touches the surface at p = c - R n, off the plane by R (N . n) where
+//         the surface slopes across it; the contacts of plane w are the points with
+//         W(p) = N . (p + R n(p)) = w, not the section. Along the cross direction the centre
+//         moves on the offset circle (radius rho + R): W(l) - W(0) = (1 + R kappa)
+//         (a S(l) - b C(l)), so the neighbour's contact lies contactDistance(delta /
+//         (1 + R kappa)) away, and the cusp is cuspHeight of that l. The surface is sampled
+//         on a grid per patch (about two samples per flat step-over across its control box,
+//         16 to 128 per side), each sample with its W; a pair (w, w + delta) is judged by the
+//         worst cusp, both directions, of the samples with W in [w, w + delta] (each taken as
+//         if it were the contact: the strip's worst local geometry). The extent is that of
+//         W over the samples, so the outermost planes lie beyond the surface's own extent
+//         where it slopes across them (raster drops balls from such planes onto the surface,
+//         raster.hpp). cuspStatistics judges its pairs the same way (sections unused).
 // Tolerance: cuspHeight is exact up to rounding (relative ~1e-15 of R, no cancellation of
 //         R - sqrt); the contact distance to 1e-14 relative; the adaptive step is within
 //         (ceiling - floor) / 2^bisectionSteps of the largest accepted one (bisection does
@@ -141,6 +157,9 @@ struct CuspOptions {
   int bisectionSteps = 14;        ///< sections per step at most (plus two)
   double floorFraction = 0.02;    ///< floor = floorFraction * l_H
   double maxStepFactor = 4.0;     ///< ceiling = maxStepFactor * l_H
+  /// The planes hold the balls' centres, not their contacts (raster: the scallop hull and the
+  /// drop envelope place the centre in the plane; see "Centre planes" in the contract).
+  bool centrePlanes = false;
 };
 
 /// Cusp heights between consecutive planes of `planes` (increasing offsets), sampled at

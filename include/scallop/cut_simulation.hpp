@@ -75,6 +75,18 @@
 //         curved surfaces) (max, where, 99th percentile, mean, points and area above H:
 //         "uncut"), counts of moves, rapids that cut (> gougeTolerance below
 //         what was there) and the first such line. Deterministic.
+// Reach:  a point q left more than H above the surface is "unreachable" when the ball
+//         cannot come within H of it from above at all, as near as one can tell: the ball
+//         touches q only from c = q + R n (n the upward unit normal; q's foot found by
+//         gouge.hpp's closest point), and if the drop envelope over c (envelope.hpp's
+//         DropCutter: the lowest centre on that vertical proven clear of the whole surface)
+//         lies L above c, the ball there stays |c + L z - q| - R = sqrt(R^2 + 2 R L n_z +
+//         L^2) - R from q. Where that exceeds H (a concave radius below R, a gap narrower than
+//         the ball, a wall) the point is counted in `unreachable` (area, worst material left:
+//         a smaller tool's work) and left out of the scallop figures, which are then the
+//         plan's own doing. Not a proof that no other centre comes nearer (a centre beside c
+//         may): a heuristic classification of what is left, in the report for what it is.
+//         Only points above H are classified, on every core, within maxReachChecks.
 // Cost:   O(P + sum over moves of the grid points within R of the move's box) time,
 //         O(P) memory, P the grid points; the design O(P) Newton solves of a few steps.
 // Errors: scallop::Error for invalid options (naming the option and value), non-finite
@@ -157,6 +169,12 @@ struct SimulationOptions {
   /// A gouge deeper than this counts (points, area, the CLI's --fail-on-gouge); >= 0.
   /// NaN: 1e-4 in or 0.0025 mm (ten quanta of the G-code's rounding, gcode.hpp).
   double gougeTolerance = std::numeric_limits<double>::quiet_NaN();
+  /// Tell the points left above H that the ball cannot reach from above from those it
+  /// could (see the contract's Reach); false: every point counts in the scallop figures.
+  bool classifyReach = true;
+  /// Budget: reach checks (one closest point and one drop-cutter height each); past it the
+  /// remaining points count as reachable (in the scallop figures), and the report says so.
+  std::size_t maxReachChecks = 400'000;
   std::size_t maxPoints = 4'000'000;  ///< grid budget (three doubles per point: 96 MB)
   /// Sweep budget: the (move, grid point) pairs in the moves' boxes grown by R, summed
   /// before the sweep (about a minute of work at the measured 50-60 million per second).
@@ -185,8 +203,17 @@ struct SimulationReport {
   std::optional<Vec3> maxScallopAt;    ///< (x, y, design z)
   double scallopP99 = 0.0;             ///< 99th percentile of the scallop over surface points
   double meanScallop = 0.0;
-  std::size_t uncutPoints = 0;         ///< scallop > H
+  std::size_t uncutPoints = 0;         ///< scallop > H, reachable
   double uncutArea = 0.0;              ///< uncutPoints d^2
+  /// Per grid point: 1 where the scallop exceeds H and the ball cannot reach (see Reach).
+  std::vector<unsigned char> unreachable;
+  std::size_t unreachablePoints = 0;   ///< out of the scallop figures above
+  double unreachableArea = 0.0;        ///< unreachablePoints d^2: left for a smaller tool
+  double maxUnreachableScallop = 0.0;  ///< the material left there, at most
+  std::optional<Vec3> maxUnreachableAt;
+  std::size_t reachChecks = 0;         ///< points classified
+  bool reachBudgetExhausted = false;   ///< some points above H were not classified
+  double reachSeconds = 0.0;
   std::size_t sweptPointVisits = 0;    ///< (move, grid point) pairs evaluated
   double designSeconds = 0.0;
   double sweepSeconds = 0.0;

@@ -34,6 +34,10 @@
 //           subdivision with sagitta s <= eps / 4 is proven R - eps + s clear (every point of
 //           the arc lies within s of its chord); otherwise it becomes straight moves through
 //           points of the arc, lifted and refined as lines are;
+//         - with a sag tolerance s > 0, a proven straight move longer than sqrt(8 R s)
+//           whose midpoint lies more than s above the envelope is split there (the
+//           midpoint lowered onto the envelope), so that no move leaves more than about s
+//           of material where the envelope sags between its ends;
 //         - a move not proven is halved, its midpoint lifted as a vertex, and each half tried
 //           again, at most kEnvelopeMaxHalvings times, then kept with its depth unproven
 //           (counted in EnvelopeReport::unprovenMoves; none on the paper's surfaces or the
@@ -59,6 +63,8 @@
 //         curved stretch of lifted path (rho the path's radius of curvature).
 
 #include <cstddef>
+#include <limits>
+#include <memory>
 #include <vector>
 
 #include "scallop/gouge.hpp"
@@ -82,6 +88,12 @@ struct EnvelopeOptions {
   std::size_t maxCellsPerProof = 100'000;
   /// Threads lifting passes at once; 0: every core. The result is the same for any number.
   std::size_t threads = 0;
+  /// > 0: a straight move longer than sqrt(8 R sagTolerance) whose midpoint lies more than
+  /// this above the envelope there (its drop-cutter height) is split there, the midpoint
+  /// lowered onto the envelope, and each half tried again (within kEnvelopeMaxHalvings):
+  /// where the envelope sags between two lifted vertices (a valley across the pass) a
+  /// straight move would leave that much material. 0: moves are only split when not clear.
+  double sagTolerance = 0.0;
 };
 
 /// A run of consecutive output vertices of one pass lifted by more than the threshold: an
@@ -115,5 +127,84 @@ struct EnvelopeReport {
 ToolPath liftToDropEnvelope(const SurfaceDistance& distance, const ToolPath& path,
                             const EnvelopeOptions& options, EnvelopeReport& report,
                             std::vector<std::vector<std::size_t>>* moveMap = nullptr);
+
+/// Drop-cutter heights: the drop envelope Z(x, y) at points one after another, each lifted
+/// from below the whole surface as liftToDropEnvelope lifts a vertex (the lowest height found
+/// within eps / 4 from which the vertical segment up to Ztop is proven R - eps / 2 clear;
+/// -infinity where no surface point lies within R of the vertical line). The last contact
+/// seeds the next point's Newton solve: neighbouring points cost about one proof each. Not
+/// thread-safe (one per thread). Errors: R not positive and finite, eps >= R.
+class DropCutter {
+ public:
+  DropCutter(const SurfaceDistance& distance, double radius, const EnvelopeOptions& options = {});
+  ~DropCutter();
+  DropCutter(const DropCutter&) = delete;
+  DropCutter& operator=(const DropCutter&) = delete;
+  double height(double x, double y);
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+/// Running a pass on past one of its ends, over the surface's edge.
+///
+/// Contract
+/// --------
+/// Why:    a pass that stops where its plane leaves the surface (or R beyond, as the scallop
+///         hull ends) leaves the surface along an edge uncut where the edge crosses the planes
+///         obliquely and the surface slopes down to it: the ball finishes a point q near the
+///         edge only from its centre q + R n(q), R |n_xy(q)| beyond the edge, which the plane
+///         through that centre reaches up to R |n_xy| / sin(angle between edge and plane)
+///         further on than where it left the surface; and the edge line itself between two
+///         passes is touched only by balls beside it.
+/// Input:  the pass's end centre `end`, a direction whose horizontal part is not zero (the
+///         pass's, onwards; none: nothing to run on), R > 0, the pass's band (below), a step
+///         > 0 and a length >= 0.
+/// Band:   which surface points the pass is responsible for, by the plane coordinate of the
+///         centre that finishes them: W(q) = normal . (q + offset n(q)), n the upward unit
+///         normal; offset 0 for contour (the contacts lie in the planes, normal . q = w),
+///         R for raster (the centres lie in the planes, e . c = w). The band is [lo, hi],
+///         half way to the neighbouring planes, unbounded beyond the outermost ones.
+/// Output: the vertices c_k = end_xy + k step h (h the horizontal unit direction), k = 1, 2,
+///         ..., each at the height where it stands on the drop envelope: lifted from below the
+///         whole surface exactly as liftToDropEnvelope lifts a vertex (the lowest height found
+///         within eps / 4 from which the vertical segment up to Ztop is proven R - eps / 2
+///         clear). The run goes on to the last c_k within `length` before the first one
+///         that has no surface point within R of its vertical line (proven: it stands at
+///         the bottom), and is then cut back to its last vertex that touches the surface
+///         inside the band (W(q) of its closest surface point q, within the distance's
+///         tolerance, in [lo, hi]); vertices between that touch a neighbour's points stay
+///         (beyond an edge a ball grazes the edge's points, a neighbour's, before it reaches
+///         the offsets of its own).
+///         The moves between them are not proven here (liftToDropEnvelope proves them).
+/// Cost:   per vertex one lift (a Newton solve and a proof or two) and one closest point.
+struct RunOnBand {
+  Vec3 normal;          ///< unit
+  double offset = 0.0;  ///< 0 (contour) or R (raster), see the contract
+  double lo = -std::numeric_limits<double>::infinity();
+  double hi = std::numeric_limits<double>::infinity();
+};
+
+/// How far past its ends (in R) the strategies let a pass run on: an edge sloping down at 35
+/// degrees and crossing the planes at 15 needs 2.2 R.
+inline constexpr double kRunOnLength = 4.0;
+
+std::vector<Vec3> runOnPastEnd(const SurfaceDistance& distance, Vec3 end, Vec3 direction,
+                               double radius, const RunOnBand& band, double step, double length,
+                               const EnvelopeOptions& options = {});
+
+/// The drop envelope along the horizontal line origin + t h, t in [from, to] (h the unit
+/// horizontal direction), in runs. The vertices c_k at t = from + k step, k = 0, 1, ..., are
+/// dropped onto the envelope as runOnPastEnd's are; a run is a maximal sequence of
+/// consecutive vertices that touch the surface inside the band, kept when it has two or more.
+/// What a raster plane that its section does not reach (or barely) contributes: its balls
+/// still finish points beside it, shifted across the plane by up to R where the surface
+/// slopes across it. Errors as runOnPastEnd's, a vertical direction, more than 10 million
+/// steps.
+std::vector<std::vector<Vec3>> dropLineRuns(const SurfaceDistance& distance, Vec3 origin,
+                                            Vec3 direction, double from, double to, double radius,
+                                            const RunOnBand& band, double step,
+                                            const EnvelopeOptions& options = {});
 
 }  // namespace scallop

@@ -43,6 +43,14 @@
 //            farther than R horizontally): the traverse and the vertical moves above Z + R
 //            are clear. The vertical moves below Z + R, E up and S down, are proven by sphere
 //            tracing to keep depth <= a(E) (resp. a(S)). d = min(plunge, h - S.z);
+//         1b. else, when |S - E| <= directLinkMax, the feed over the drop envelope: [E, S]
+//            lifted by liftToDropEnvelope (envelope.hpp, eps = epsilon, every move proven to
+//            cut no deeper than epsilon) when that leaves both ends where they are; its
+//            moves go in front of the pass (LinkedPath::linkMoves), which then starts at E
+//            (retractBefore = false). Why: two ends beside an edge or on a crest touch the
+//            surface, and the straight feed between them dips into it where the envelope
+//            sags (contour passes that run on past the edges: 0 of 83 straight feeds proven
+//            on paper-1, 82 over the envelope);
 //         3. when the vertical moves of 2 are not proven (the surface overhangs an end), the
 //            direct feed of 1 again with a larger budget of steps (1 gives up after 256 steps,
 //            where the proof creeps along a move that slides on the surface; here 4,000);
@@ -110,6 +118,7 @@ struct LinkStats {
   std::size_t reversedPasses = 0;  ///< run backwards
   std::size_t rotatedLoops = 0;    ///< closed passes started at another vertex
   std::size_t directLinks = 0;     ///< feeds at cutting height made by the linker
+  std::size_t envelopeLinks = 0;   ///< of which over the drop envelope (several moves)
   std::size_t localRetracts = 0;   ///< retracts over the local stock (first pass excluded)
   std::size_t unprovenLinks = 0;   ///< left as safe-height retracts: no proof found
   std::size_t strategyLinks = 0;   ///< the strategy's own links, left alone
@@ -127,6 +136,10 @@ struct LinkedPath {
   std::vector<std::size_t> origin;
   /// reversed[i]: output pass i runs backwards relative to the input.
   std::vector<bool> reversed;
+  /// linkMoves[i]: moves the linker put in front of output pass i (a feed over the drop
+  /// envelope from the previous pass's end, see the contract); the pass proper starts where
+  /// the last of them ends. 0 for every other pass.
+  std::vector<std::size_t> linkMoves;
   LinkStats stats;
 };
 

@@ -51,7 +51,9 @@ struct VerificationSummary {
   std::optional<Vec3> maxScallopAt;
   double scallopP99 = 0.0;
   double meanScallop = 0.0;
-  double uncutArea = 0.0;         ///< scallop above H
+  double uncutArea = 0.0;         ///< scallop above H where the ball reaches
+  double unreachableArea = 0.0;   ///< left above H beyond the ball's reach (a smaller tool's)
+  double maxUnreachableLeft = 0.0;
   std::size_t rapidsCutting = 0;
   double seconds = 0.0;
 };
@@ -93,6 +95,9 @@ struct PathsReport {
   double gougeSampleSpacing = 0.0;   ///< the spacing the gouge check sampled at
   std::optional<OrientationSummary> orientation;
   std::optional<LinkStats> linking;   ///< when the passes were linked (linking.hpp)
+  /// Per pass of the written path, the leading moves that are the linker's feed over the drop
+  /// envelope from the previous pass's end (LinkedPath::linkMoves; empty: none).
+  std::vector<std::size_t> linkMoves;
   /// The simulated cut of the written program (`scallop plan`; none for `paths`).
   std::optional<VerificationSummary> verification;
   /// The G-code program's motion and estimated cycle time (gcode.hpp's gcodeMotion), with

@@ -153,6 +153,8 @@ struct RasterOptions {
   double depthTolerance = 0.0;  /// Lifts above this are reported as stretches the ball cannot follow (>= 0); 0 means
   /// the envelope's default (10 eps). The CLI passes the scallop height.
   double stretchThreshold = 0.0;
+  /// The drop envelope's sag tolerance (envelope.hpp; >= 0, 0: off). The CLI passes H / 4.
+  double sagTolerance = 0.0;
   /// Explicit plane offsets w (strictly increasing, finite, at most kMaxPlanes), used instead
   /// of k Delta when non-empty: the planes e . r = planeOffsets[k] (cusp.hpp's
   /// adaptivePlaneOffsets with N = e). Delta (spacing, or from scallopHeight) is then only
@@ -174,6 +176,9 @@ struct RasterSection {
   PlaneSection section;             ///< planeSection(surface, e, w, chordal tolerance)
   std::vector<RasterChain> chains;  ///< in increasing s
   bool reversed = false;            ///< its passes run toward decreasing s (zigzag)
+  /// A plane beyond the outermost given ones (with the drop envelope only; k beyond them):
+  /// no chains, its passes are runs of the drop envelope along its line (see the contract).
+  bool dropLine = false;
 };
 
 /// What one pass of the tool path is.
