@@ -14,11 +14,16 @@
 //   BM_LinkContour/<surface>  linkToolPath on the contour plan's path (made once, outside
 //                             the loop): ordering and proven links, per pass
 //   BM_LinkRaster/<surface>   the same on the raster plan's path
+//   BM_DropCutter/<surface>/<warm>  DropCutter heights (envelope.hpp) on a 100 x 100 grid over
+//                             the surface's footprint grown by R, row by row: one cutter for
+//                             the grid (1: each point seeded by the last contact) or a new one
+//                             per point (0: cold); points per second
 
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -185,6 +190,29 @@ void BM_LinkRaster(benchmark::State& state) {
 
 }  // namespace
 
+void BM_DropCutter(benchmark::State& state) {
+  const scallop::Surface surface = scallop::exampleSurface(surfaceName(state));
+  const scallop::SurfaceDistance distance(surface);
+  const bool warm = state.range(1) == 1;
+  constexpr int kGrid = 100;
+  double sum = 0.0;
+  for (auto _ : state) {
+    std::optional<scallop::DropCutter> cutter;
+    if (warm) cutter.emplace(distance, kToolRadius);
+    for (int j = 0; j < kGrid; ++j)
+      for (int i = 0; i < kGrid; ++i) {
+        if (!warm) cutter.emplace(distance, kToolRadius);
+        const double x = -kToolRadius + (3.0 + 2.0 * kToolRadius) * i / (kGrid - 1.0);
+        const double y = -kToolRadius + (3.0 + 2.0 * kToolRadius) * j / (kGrid - 1.0);
+        sum += cutter->height(x, y);
+      }
+  }
+  benchmark::DoNotOptimize(sum);
+  state.counters["points_per_s"] = benchmark::Counter(double(kGrid * kGrid), benchmark::Counter::kIsIterationInvariantRate);
+  state.SetLabel(std::string(surfaceName(state)) + (warm ? " warm" : " cold"));
+}
+
+BENCHMARK(BM_DropCutter)->Args({1, 1})->Args({1, 0})->Args({2, 1})->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LinkContour)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LinkRaster)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_PlanContour)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
