@@ -283,7 +283,13 @@ PassLift liftPass(const SurfaceDistance& distance, const ToolPass& pass, std::si
           std::hypot(to.x - from.x, to.y - from.y) > sagLength) {
         const Vec3 middle = 0.5 * (from + to);
         const Vec3 onEnvelope = lifter.lift({middle.x, middle.y, bottom});
-        if (onEnvelope.z > bottom && onEnvelope.z < middle.z - options.sagTolerance) {
+        // Only a move whose ends stand on the envelope cuts along it: one with an end in the
+        // air (a link rising, crossing at its height, coming down) is left as it is.
+        const auto onTheEnvelope = [&](Vec3 p) {
+          return lifter.lift({p.x, p.y, bottom}).z >= p.z - options.sagTolerance;
+        };
+        if (onEnvelope.z > bottom && onEnvelope.z < middle.z - options.sagTolerance &&
+            onTheEnvelope(from) && onTheEnvelope(to)) {
           self(self, from, onEnvelope, kInserted, halvings + 1);
           self(self, onEnvelope, to, toLift, halvings + 1);
           return;

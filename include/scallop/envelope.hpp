@@ -35,9 +35,10 @@
 //           the arc lies within s of its chord); otherwise it becomes straight moves through
 //           points of the arc, lifted and refined as lines are;
 //         - with a sag tolerance s > 0, a proven straight move longer than sqrt(8 R s)
-//           whose midpoint lies more than s above the envelope is split there (the
-//           midpoint lowered onto the envelope), so that no move leaves more than about s
-//           of material where the envelope sags between its ends;
+//           whose ends both stand within s of the envelope and whose midpoint lies more
+//           than s above it is split there (the midpoint lowered onto the envelope), so that
+//           no cutting move leaves more than about s of material where the envelope sags
+//           between its ends; moves with an end in the air (links) are left alone;
 //         - a move not proven is halved, its midpoint lifted as a vertex, and each half tried
 //           again, at most kEnvelopeMaxHalvings times, then kept with its depth unproven
 //           (counted in EnvelopeReport::unprovenMoves; none on the paper's surfaces or the
@@ -88,7 +89,8 @@ struct EnvelopeOptions {
   std::size_t maxCellsPerProof = 100'000;
   /// Threads lifting passes at once; 0: every core. The result is the same for any number.
   std::size_t threads = 0;
-  /// > 0: a straight move longer than sqrt(8 R sagTolerance) whose midpoint lies more than
+  /// > 0: a straight move longer than sqrt(8 R sagTolerance), both of whose ends stand within
+  /// this of the envelope, and whose midpoint lies more than
   /// this above the envelope there (its drop-cutter height) is split there, the midpoint
   /// lowered onto the envelope, and each half tried again (within kEnvelopeMaxHalvings):
   /// where the envelope sags between two lifted vertices (a valley across the pass) a
