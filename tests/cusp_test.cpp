@@ -2,7 +2,8 @@
 // module: the cusp of two circles whose centres lie on the offset of a circle, intersected by
 // bisection; curvature of an explicit graph; cylinders built as Bezier patches from an
 // interpolant of the circle; and, as the judge of the real scallop, the lower envelope of the
-// swept balls of the contour passes over dense surface samples (exact ray / capsule tests).
+// swept balls of the contour passes over dense surface samples (exact ray / capsule tests),
+// and likewise of raster passes on centre planes dropped onto the drop envelope.
 
 #include <gtest/gtest.h>
 
@@ -13,6 +14,8 @@
 #include <limits>
 #include <numbers>
 #include <random>
+#include <string>
+#include <tuple>
 #include <cstdio>
 #include <cstdlib>
 #include <unordered_map>
@@ -20,7 +23,9 @@
 #include "scallop/bezier.hpp"
 #include "scallop/contour.hpp"
 #include "scallop/cusp.hpp"
+#include "scallop/envelope.hpp"
 #include "scallop/error.hpp"
+#include "scallop/gouge.hpp"
 #include "scallop/raster.hpp"
 #include "scallop/section.hpp"
 #include "scallop/surface.hpp"
@@ -647,6 +652,279 @@ TEST(CuspJudgeCylinder, ConstantExceedsHAdaptiveDoesNot) {
   EXPECT_GT(constant, 1.05 * h);
   EXPECT_LE(adaptive, 1.02 * h);
   EXPECT_GE(adaptive, 0.9 * h);
+}
+
+// ---- raster: centre planes ----
+
+// The swept balls of raster passes on centre planes e . c = w_k, as the model means them: on
+// each plane the ball centres dropped onto the drop envelope (the library's DropCutter,
+// tested against a brute-force drop in envelope_test.cpp) at t = t0 + i step along the plane's
+// line (direction d, horizontal), over the surface's box grown by R; straight moves between
+// consecutive finite heights (a pass ends where nothing lies within R). A chord lies within
+// step^2 / (8 rho) of the envelope (rho its radius along the pass): below it where the
+// envelope is convex (rho >= R there), which could hide material, by at most step^2 / (8 R),
+// 0.8 % of H at the callers' step R / 64 (R = 0.25 in, H = 0.001 in; R = 1 in, H = 0.004 in);
+// above it where concave, which can only overstate the scallop. Indexed by plane and
+// position, so that a query tests only the moves whose balls can reach it: blocks of 8 moves
+// bounded by spheres, then the capsules.
+struct RasterBalls {
+  Vec3 e, d;
+  double radius = 0.0, cap = 0.0, t0 = 0.0, step = 0.0;
+  std::vector<double> offsets;
+  std::vector<std::vector<Vec3>> centres;  // per plane, per index (z NaN: none)
+  struct Block {
+    Vec3 centre;
+    double reach = 0.0;
+  };
+  std::vector<std::vector<Block>> blocks;  // per plane, moves [8b, 8b + 8]
+  static constexpr std::size_t kBlock = 8;
+
+  RasterBalls(const Surface& s, const Vec3& normal, double r, double heightCap,
+              const std::vector<double>& planes, double spacing)
+      : e(normal), d{-normal.y, normal.x, 0.0}, radius(r), cap(heightCap), step(spacing), offsets(planes) {
+    const scallop::SurfaceDistance distance(s);
+    scallop::DropCutter cutter(distance, r);
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    Vec3 boxLo{lo, lo, 0.0}, boxHi{hi, hi, 0.0};
+    for (const BezierPatch& patch : s.patches)
+      for (const Vec3& c : patch.control) {
+        lo = std::min(lo, scallop::dot(d, c)), hi = std::max(hi, scallop::dot(d, c));
+        boxLo = {std::min(boxLo.x, c.x - r), std::min(boxLo.y, c.y - r), 0.0};
+        boxHi = {std::max(boxHi.x, c.x + r), std::max(boxHi.y, c.y + r), 0.0};
+      }
+    t0 = lo - r;
+    const auto count = static_cast<std::size_t>((hi - lo + 2.0 * r) / step) + 1;
+    for (const double w : offsets) {
+      centres.emplace_back();
+      blocks.emplace_back();
+      // Only where the line crosses the control box grown by R is anything within R.
+      double tMin = -std::numeric_limits<double>::infinity(), tMax = -tMin;
+      for (const auto& [o, dir, a, b] : {std::tuple{w * e.x, d.x, boxLo.x, boxHi.x}, std::tuple{w * e.y, d.y, boxLo.y, boxHi.y}}) {
+        if (std::abs(dir) < 1e-12) continue;
+        const double t1 = (a - o) / dir, t2 = (b - o) / dir;
+        tMin = std::max(tMin, std::min(t1, t2)), tMax = std::min(tMax, std::max(t1, t2));
+      }
+      for (std::size_t i = 0; i < count; ++i) {
+        const double t = t0 + double(i) * step;
+        const Vec3 c = w * e + t * d;
+        const double z = t >= tMin && t <= tMax ? cutter.height(c.x, c.y) : -std::numeric_limits<double>::infinity();
+        centres.back().push_back({c.x, c.y, std::isfinite(z) ? z : std::nan("")});
+      }
+      for (std::size_t b = 0; b * kBlock + 1 < count; ++b) {
+        const std::size_t first = b * kBlock, last = std::min(count - 1, first + kBlock);
+        // A finite representative (the middle one if it is), and the block's radius about it.
+        Block block{centres.back()[(first + last) / 2], 0.0};
+        for (std::size_t i = first; i <= last && std::isnan(block.centre.z); ++i) block.centre = centres.back()[i];
+        for (std::size_t i = first; i <= last; ++i)
+          if (!std::isnan(centres.back()[i].z))
+            block.reach = std::max(block.reach, scallop::norm(centres.back()[i] - block.centre));
+        blocks.back().push_back(block);
+      }
+    }
+  }
+
+  std::size_t moves() const {
+    std::size_t n = 0;
+    for (const auto& plane : centres)
+      for (std::size_t i = 0; i + 1 < plane.size(); ++i) n += !std::isnan(plane[i].z) && !std::isnan(plane[i + 1].z);
+    return n;
+  }
+
+  // Material left above surface point p (unit normal n): the smallest t in [0, cap] with
+  // p + t n inside a swept ball (cap when none). A ball reaching the ray has its centre within
+  // R + cap of p, so only planes with |w - e . p| <= R + cap and blocks whose sphere comes
+  // that near are tested.
+  double height(const Vec3& p, const Vec3& n) const {
+    double best = cap;
+    const double reach = radius + cap;
+    const double ep = scallop::dot(e, p);
+    const auto first = std::lower_bound(offsets.begin(), offsets.end(), ep - reach) - offsets.begin();
+    for (auto k = static_cast<std::size_t>(first); k < offsets.size() && offsets[k] <= ep + reach; ++k) {
+      const std::vector<Vec3>& plane = centres[k];
+      for (std::size_t b = 0; b < blocks[k].size(); ++b) {
+        const Block& block = blocks[k][b];
+        if (std::isnan(block.centre.z) || scallop::norm(block.centre - p) > reach + block.reach) continue;
+        const std::size_t from = b * kBlock, to = std::min(plane.size() - 1, from + kBlock);
+        for (std::size_t i = from; i < to; ++i) {
+          if (std::isnan(plane[i].z) || std::isnan(plane[i + 1].z)) continue;
+          best = std::min(best, rayCapsule(p, n, plane[i], plane[i + 1], radius));
+        }
+      }
+    }
+    return best;
+  }
+};
+
+// The largest material height over straight xy lines along e (across the passes, so each
+// line crosses every ridge between neighbouring passes and none of the ripples along a pass),
+// `lines` of them spaced along d, `samples` points each; local maxima refined by golden
+// section. `uv` maps (x, y) to the patch's parameters (the test surfaces are graphs with x and
+// y linear in u and v). Only points 3 % in from the patch's edges count, and only those whose
+// touching centre's plane coordinate W = e . (p + R n) lies between the first and last planes.
+double judgeRasterScallop(const Surface& s, const RasterBalls& balls,
+                          const std::function<std::pair<double, double>(double, double)>& uv, int lines,
+                          int samples) {
+  const BezierPatch& patch = s.patches.front();
+  const double margin = 0.03;
+  // The lines: the footprint's extent along d and e (its control box).
+  double dLo = std::numeric_limits<double>::infinity(), dHi = -dLo, eLo = dLo, eHi = -dLo;
+  for (const Vec3& c : patch.control) {
+    dLo = std::min(dLo, scallop::dot(balls.d, c)), dHi = std::max(dHi, scallop::dot(balls.d, c));
+    eLo = std::min(eLo, scallop::dot(balls.e, c)), eHi = std::max(eHi, scallop::dot(balls.e, c));
+  }
+  const auto at = [&](double along, double across) {
+    const Vec3 xy = along * balls.d + across * balls.e;
+    const auto [u, v] = uv(xy.x, xy.y);
+    if (u < margin || u > 1.0 - margin || v < margin || v > 1.0 - margin) return 0.0;
+    const Vec3 p = scallop::point(patch, u, v);
+    const Vec3 normal = scallop::upwardNormal(s, 0, u, v);
+    const double w = scallop::dot(balls.e, p + balls.radius * normal);
+    if (w < balls.offsets.front() || w > balls.offsets.back()) return 0.0;
+    return balls.height(p, normal);
+  };
+  double worst = 0.0;
+  for (int line = 1; line < lines; ++line) {
+    const double along = dLo + (dHi - dLo) * line / lines;
+    const double step = (eHi - eLo) / samples;
+    std::vector<double> hs(static_cast<std::size_t>(samples) + 1);
+    for (int i = 0; i <= samples; ++i) hs[static_cast<std::size_t>(i)] = at(along, eLo + step * i);
+    for (int i = 1; i < samples; ++i) {
+      const auto iu = static_cast<std::size_t>(i);
+      if (!(hs[iu] >= hs[iu - 1] && hs[iu] >= hs[iu + 1]) || !(hs[iu] > 0.0) ||
+          !(hs[iu] > hs[iu - 1] || hs[iu] > hs[iu + 1]))
+        continue;
+      double a = eLo + step * (i - 1), b = eLo + step * (i + 1), best = hs[iu];
+      for (int g = 0; g < 30; ++g) {
+        const double x1 = b - 0.618033988749895 * (b - a), x2 = a + 0.618033988749895 * (b - a);
+        const double h1 = at(along, x1), h2 = at(along, x2);
+        best = std::max({best, h1, h2});
+        if (h1 > h2) b = x2; else a = x1;
+      }
+      worst = std::max(worst, best);
+    }
+  }
+  return worst;
+}
+
+class CuspCentrePlanes : public ::testing::TestWithParam<std::tuple<const char*, double, double>> {};
+
+// The adaptive centre-plane offsets (CuspOptions::centrePlanes) keep the real raster scallop
+// below H: planes e . c = w at a feed angle, their passes on the drop envelope, and the
+// scallop the swept balls leave (RasterBalls, judgeRasterScallop). The judge can misstate the
+// scallop of the envelope's centres by the chords' sag (under 1 % of H where it hides
+// material, see RasterBalls), by eps / 4 of the heights (1e-6 in) and understates it between
+// its lines along a ridge; the model is exact on cylinders (the next test) and second order
+// elsewhere (the curvature changes across a step): 5 % over H is allowed, as for the contour
+// judge. And the centre planes are not absurdly dense: at most twice the contact-plane
+// model's. The figures printed: planes, the model's worst pair, the judged worst.
+TEST_P(CuspCentrePlanes, AdaptiveRasterScallopStaysBelowH) {
+  const auto [name, radius, angle] = GetParam();
+  const double h = radius == 0.25 ? 0.001 : 0.004;
+  const Surface s = scallop::exampleSurface(name);
+  const Vec3 e{-std::sin(angle), std::cos(angle), 0.0};
+  scallop::CuspOptions cusp;
+  cusp.toolRadius = radius;
+  cusp.scallopHeight = h;
+  cusp.centrePlanes = true;
+  const scallop::AdaptiveOffsets a = scallop::adaptivePlaneOffsets(s, e, cusp);
+  cusp.centrePlanes = false;
+  const scallop::AdaptiveOffsets contact = scallop::adaptivePlaneOffsets(s, e, cusp);
+  double model = 0.0;
+  for (const double c : a.worstCusp) model = std::max(model, c);
+  const RasterBalls balls(s, e, radius, 10.0 * h, a.offsets, radius / 64.0);
+  // The paper's surfaces: x = 3 v, y = 3 u (p_jk = (k, j, z)).
+  const double judged = judgeRasterScallop(s, balls, [](double x, double y) { return std::pair{y / 3.0, x / 3.0}; },
+                                           30, 600);
+  std::printf("[          ] %s R %g angle %g: %zu centre planes (%zu contact planes), %zu moves; model's worst "
+              "%.4g H, judged %.4g H\n",
+              name, radius, angle, a.offsets.size(), contact.offsets.size(), balls.moves(), model / h, judged / h);
+  EXPECT_LE(judged, 1.05 * h);
+  EXPECT_GE(judged, 0.5 * h) << "steps needlessly small";
+  EXPECT_LE(a.offsets.size(), 2 * contact.offsets.size());
+}
+
+INSTANTIATE_TEST_SUITE_P(PaperSurfaces, CuspCentrePlanes,
+                         ::testing::Values(std::tuple{"paper-1", 0.25, 0.0}, std::tuple{"paper-1", 1.0, 0.0},
+                                           std::tuple{"paper-2", 0.25, 1.0}),
+                         [](const auto& param) {
+                           std::string name = std::get<0>(param.param);
+                           name.erase(std::remove(name.begin(), name.end(), '-'), name.end());
+                           return name + (std::get<1>(param.param) == 0.25 ? "_R025" : "_R1");
+                         });
+
+
+// Cylinders about y (radius 1, |x| <= 0.6; convex and concave), planes x = w, passes along the
+// axis: the balls' centres lie on the offset circle of radius 1 +- R about the axis, at angles
+// phi = asin(w / (1 +- R)) from the top (bottom), so the cusp between centres in planes w and
+// w' is exactly the two circles' of twoCircleCusp with contacts |phi' - phi| apart on the
+// unit circle: the closed form. For every pair whose centres both touch inside the patch:
+//   - the closed form stays <= H (the offsets' purpose);
+//   - the model is exact on a cylinder but judges a pair (w, w + delta) by every sample in its
+//     strip taken as the contact, toward both neighbours: its worst lies between the pair's
+//     closed form and the worst closed form of (w', w' + delta) over w' in [w - delta, w +
+//     delta] (the samples' reach), to 1e-6 (the degree-14 interpolant of the circle is within
+//     1e-9 of it; samples are not exactly at the strip's ends);
+//   - a strip with no sample is judged 0 by the model (counted and printed: the last, narrow
+//     step beside the extent's end);
+//   - the judge (the swept balls over dense samples; straight passes, so no chord error)
+//     finds the closed form's worst where it looks (3 % in from the edges) to 1e-3 relative.
+TEST(CuspCentrePlanesCylinder, ModelAndJudgeAgainstTheClosedForm) {
+  const double rho = 1.0, half = 0.6, radius = 0.25, h = 0.001;
+  for (const bool convex : {true, false}) {
+    const Surface s = cylinder(rho, half, convex);
+    const Vec3 e{1.0, 0.0, 0.0};
+    scallop::CuspOptions cusp;
+    cusp.toolRadius = radius;
+    cusp.scallopHeight = h;
+    cusp.centrePlanes = true;
+    const scallop::AdaptiveOffsets a = scallop::adaptivePlaneOffsets(s, e, cusp);
+    cusp.centrePlanes = false;
+    const scallop::AdaptiveOffsets contact = scallop::adaptivePlaneOffsets(s, e, cusp);
+    const double offsetRadius = convex ? rho + radius : rho - radius;
+    const double reach = offsetRadius * half / rho;  // |w| of a centre touching the edge x = +-half
+    const auto closedForm = [&](double w0, double w1) {
+      const double phi0 = std::asin(w0 / offsetRadius), phi1 = std::asin(w1 / offsetRadius);
+      return twoCircleCusp(rho * std::abs(phi1 - phi0), radius, convex ? 1.0 / rho : -1.0 / rho);
+    };
+    double worstClosed = 0.0, lowRatio = 1e9, highRatio = 0.0, judgedRegionWorst = 0.0, emptyClosed = 0.0;
+    std::size_t pairs = 0, empty = 0;
+    for (std::size_t k = 0; k + 1 < a.offsets.size(); ++k) {
+      const double w0 = a.offsets[k], w1 = a.offsets[k + 1], delta = w1 - w0;
+      if (std::abs(w0) > reach || std::abs(w1) > reach) continue;
+      const double closed = closedForm(w0, w1);
+      ++pairs;
+      worstClosed = std::max(worstClosed, closed);
+      const double mid = 0.5 * (std::asin(w0 / offsetRadius) + std::asin(w1 / offsetRadius));
+      if (std::abs(rho * std::sin(mid)) < half * 0.94) judgedRegionWorst = std::max(judgedRegionWorst, closed);
+      EXPECT_LE(closed, h * (1.0 + 1e-9)) << "pair " << k;
+      if (a.worstCusp[k] == 0.0) {
+        ++empty;
+        emptyClosed = std::max(emptyClosed, closed);
+        continue;
+      }
+      double upper = 0.0;
+      for (int i = 0; i <= 400; ++i) {
+        const double w = w0 - delta + 2.0 * delta * i / 400.0;
+        if (std::abs(w) < offsetRadius && std::abs(w + delta) < offsetRadius) upper = std::max(upper, closedForm(w, w + delta));
+      }
+      EXPECT_GE(a.worstCusp[k], closed * (1.0 - 1e-6)) << "pair " << k;
+      EXPECT_LE(a.worstCusp[k], upper * (1.0 + 1e-6)) << "pair " << k;
+      lowRatio = std::min(lowRatio, a.worstCusp[k] / closed);
+      highRatio = std::max(highRatio, a.worstCusp[k] / closed);
+    }
+    const RasterBalls balls(s, e, radius, 10.0 * h, a.offsets, radius / 64.0);
+    const double judged = judgeRasterScallop(
+        s, balls, [&](double x, double y) { return std::pair{(x + half) / (2.0 * half), y}; }, 12, 1200);
+    std::printf("[          ] %s cylinder: %zu centre planes (%zu contact planes), %zu pairs inside; closed form's "
+                "worst %.5g H, the model's per pair %.4f to %.4f of it (%zu empty strips judged 0, closed form "
+                "there %.3g H); judged %.5g H (closed form there %.5g H)\n",
+                convex ? "convex" : "concave", a.offsets.size(), contact.offsets.size(), pairs, worstClosed / h,
+                lowRatio, highRatio, empty, emptyClosed / h, judged / h, judgedRegionWorst / h);
+    EXPECT_GT(pairs, 10u);
+    EXPECT_LE(empty, 1u);
+    EXPECT_NEAR(judged, judgedRegionWorst, 1e-3 * judgedRegionWorst);
+    EXPECT_LE(a.offsets.size(), 2 * contact.offsets.size());
+  }
 }
 
 }  // namespace

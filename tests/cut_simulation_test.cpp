@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdio>
 #include <limits>
 #include <numbers>
 #include <random>
@@ -16,6 +17,7 @@
 
 #include "scallop/contour.hpp"
 #include "scallop/cut_simulation.hpp"
+#include "scallop/envelope.hpp"
 #include "scallop/error.hpp"
 #include "scallop/gcode.hpp"
 #include "scallop/gcode_reader.hpp"
@@ -797,6 +799,283 @@ TEST(VerifyOutput, JsonHasNoNanAndTheSvgStaysSmall) {
   EXPECT_EQ(svg.find("nan"), std::string::npos);
   // Deterministic.
   EXPECT_EQ(svg, verifySvg(report, {"example <paper-1>", "p.ngc", 0, 0.0}));
+}
+
+
+// ---------------------------------------------------------------------------------------
+// Reach: the points left above H that the ball cannot reach from above.
+// ---------------------------------------------------------------------------------------
+
+// The valley z = k (x - 1)^2 over [0, 2]^2, exactly, as a biquadratic patch: x = 2u, y = 2v,
+// and (2u - 1)^2 has the Bernstein coefficients 1, -1, 1 (its blossom). Its bottom's radius
+// of curvature is 1 / (2k).
+Surface valley(double k) {
+  BezierPatch patch;
+  patch.degreeU = patch.degreeV = 2;
+  const double c[3] = {1.0, -1.0, 1.0};
+  for (int j = 0; j <= 2; ++j)
+    for (int i = 0; i <= 2; ++i) patch.control.push_back({double(j), double(i), k * c[j]});
+  return Surface{Units::inch, {patch}};
+}
+
+// The brute-force judge of reach on the valley, written from its profile alone. Away from the
+// ends y = 0 and y = 2 (by more than R + H) every surface point is (s, t, k (s - 1)^2), so
+// the drop envelope over (x, y) with y inside is the profile's
+//     Z(x) = max { k (s - 1)^2 + sqrt(R^2 - (s - x)^2) : s in [0, 2], |s - x| <= R },
+// taken here by 400 samples of s refined by golden sections about the best two, and the
+// ball at (x, y', Z(x)) is nearest a point q = (q_x, q_y, q_z) with y' = q_y: the smallest
+// gap |c - q| - R over the centres that can touch q is
+//     min over x in [q_x - R - H, q_x + R + H] of sqrt((x - q_x)^2 + (Z(x) - q_z)^2) - R,
+// taken over Z on a grid of x (spacing `step`, every value a genuine centre's: never below
+// the true minimum) and at the centre q + R n itself (exactly where the library looks).
+struct ValleyReach {
+  double k, R, step, x0;
+  std::vector<double> z;  // Z at x0 + i step
+
+  double profile(double x) const {
+    const double lo = std::max(0.0, x - R), hi = std::min(2.0, x + R);
+    if (lo > hi) return -kInf;
+    const auto g = [&](double s) {
+      const double d2 = (s - x) * (s - x);
+      return k * (s - 1.0) * (s - 1.0) + std::sqrt(std::max(0.0, R * R - d2));
+    };
+    constexpr int n = 400;
+    std::vector<std::pair<double, int>> samples;
+    for (int i = 0; i <= n; ++i) samples.push_back({g(lo + (hi - lo) * i / n), i});
+    std::partial_sort(samples.begin(), samples.begin() + 2, samples.end(), std::greater<>());
+    double best = samples[0].first;
+    for (int b = 0; b < 2; ++b) {
+      double a = lo + (hi - lo) * std::max(0, samples[b].second - 1) / n;
+      double c = lo + (hi - lo) * std::min(n, samples[b].second + 1) / n;
+      const double r = (std::sqrt(5.0) - 1.0) / 2.0;
+      for (int it = 0; it < 80; ++it) {
+        const double x1 = c - r * (c - a), x2 = a + r * (c - a);
+        const double g1 = g(x1), g2 = g(x2);
+        best = std::max({best, g1, g2});
+        if (g1 > g2) c = x2; else a = x1;
+      }
+    }
+    return best;
+  }
+
+  ValleyReach(double k_, double R_, double h, double step_) : k(k_), R(R_), step(step_), x0(-R_ - h - 0.05) {
+    for (double x = x0; x <= 2.0 + R + h + 0.05; x += step) z.push_back(profile(x));
+  }
+
+  // The least gap for the surface point over (qx, *), and the gap at q + R n alone.
+  std::pair<double, double> gap(double qx, double h) const {
+    const double qz = k * (qx - 1.0) * (qx - 1.0);
+    const auto at = [&](double x, double zx) { return std::hypot(x - qx, zx - qz) - R; };
+    double best = kInf;
+    const auto first = static_cast<std::size_t>(std::max(0.0, std::floor((qx - R - h - x0) / step)));
+    for (std::size_t i = first; i < z.size() && x0 + double(i) * step <= qx + R + h; ++i)
+      best = std::min(best, at(x0 + double(i) * step, z[i]));
+    const double slope = 2.0 * k * (qx - 1.0);
+    const double nx = -slope / std::hypot(slope, 1.0);
+    const double cx = qx + R * nx;
+    const double own = at(cx, profile(cx));
+    return {std::min(best, own), own};
+  }
+};
+
+// The report's figures follow from its own grids and flags.
+void expectReachBookkeeping(const SimulationReport& report, double height, const std::string& what) {
+  std::size_t above = 0, flagged = 0, uncut = 0;
+  double maxFlagged = 0.0, maxOther = 0.0;
+  const double cell = report.design.spacing * report.design.spacing;
+  for (std::size_t i = 0; i < report.design.z.size(); ++i) {
+    if (report.design.z[i] == -kInf) {
+      EXPECT_EQ(report.unreachable[i], 0) << what << " point " << i << ": no surface";
+      continue;
+    }
+    const double scallop = std::max(0.0, report.stock.z[i] - report.design.z[i]) * report.designNormalZ[i];
+    if (scallop > height) ++above;
+    if (report.unreachable[i]) {
+      EXPECT_GT(scallop, height) << what << " point " << i << ": classified, yet not above H";
+      ++flagged;
+      maxFlagged = std::max(maxFlagged, scallop);
+    } else {
+      uncut += scallop > height;
+      maxOther = std::max(maxOther, scallop);
+    }
+  }
+  EXPECT_EQ(report.unreachablePoints, flagged) << what;
+  EXPECT_NEAR(report.unreachableArea, double(flagged) * cell, 1e-12) << what;
+  EXPECT_NEAR(report.maxUnreachableScallop, maxFlagged, 1e-12) << what;
+  EXPECT_EQ(report.uncutPoints, uncut) << what;
+  EXPECT_NEAR(report.uncutArea, double(uncut) * cell, 1e-12) << what;
+  EXPECT_NEAR(report.maxScallop, maxOther, 1e-12) << what;
+  EXPECT_EQ(report.reachChecks, std::min(above, std::size_t{400'000})) << what;
+}
+
+// The valley z = 2 (x - 1)^2 (bottom radius 0.25 in) under a ball of R = 0.5 in, H = 0.002 in:
+// the ball wedges between the walls, touching them at t0 = sqrt(4 k^2 R^2 - 1) / (2k) either
+// side of the bottom (t = x - 1), and cannot finish what lies between. Passes along y over the
+// left wall (vertices every 0.05 in below the surface, lifted onto the envelope) cut part of
+// it; elsewhere the finishing stock a = 0.05 in stays (a |n_z| > H everywhere below the flat
+// top). Every point the report classifies, away from the ends y = 0 and 2 (where the judge's
+// symmetry holds), against ValleyReach's least gap over all centres:
+//   - classified reachable: the ball at q + R n touched within H by the library's envelope,
+//     which lies below the true one by at most the height that loses eps / 2 of clearance,
+//     eps / (2 n_z) <= 2.1 eps on these walls (n_z >= 1 / sqrt(17)): least gap <= H + 2.1 eps;
+//   - classified unreachable: least gap > H, except in the band next to the wedge contacts
+//     where the heuristic cannot see the wedged ball: the wedged ball is tangent to the wall at
+//     t0, and at arc length sigma from there the gap between them is sigma^2 (1/R - kappa) / 2
+//     to leading order (kappa = 2k / (1 + 4k^2 t0^2)^(3/2) the profile's curvature there), so
+//     the wedged ball comes within H of the points with |t| > t0 - Delta_H, Delta_H =
+//     sqrt(2H / ((1/R - kappa)(1 + 4k^2 t0^2))), while their own centres q + R n stand on the
+//     envelope's steep branch beside the wedge, lifted more than H. The contract says so ("a
+//     centre beside c may come nearer"); the band is checked to be where the misses are
+//     (within 1.5 Delta_H: the next term is O(sigma^3)) and the figures printed.
+TEST(CutSimulationReach, ValleyTighterThanTheBallAgainstABruteForceJudge) {
+  const double k = 2.0, R = 0.5, H = 0.002;
+  const Surface surface = valley(k);
+  ToolPath path;
+  path.toolRadius = R;
+  for (double x = 0.5; x <= 0.95; x += 0.03) {
+    ToolPass pass{{x, 0.0, -1.0}, {}, true};
+    for (int j = 1; j <= 40; ++j) pass.moves.push_back({MoveKind::line, {x, 0.05 * j, -1.0}, {}, ArcPlane::xy, true});
+    path.passes.push_back(pass);
+  }
+  EnvelopeReport lift;
+  path = liftToDropEnvelope(SurfaceDistance(surface), path, {}, lift);
+  ASSERT_EQ(lift.unprovenMoves, 0u);
+  SimulationOptions options;
+  options.toolRadius = R;
+  options.scallopHeight = H;
+  options.resolution = 0.02;
+  options.stockAllowance = 0.05;
+  options.stockTop = 3.0;
+  const SimulationReport report = verifyToolPath(surface, path, options);
+  expectReachBookkeeping(report, H, "valley");
+  EXPECT_FALSE(report.reachBudgetExhausted);
+  const ValleyReach judge(k, R, H, 1e-4);
+  const double eps = 1e-6 * surfaceScale(surface);
+  const double t0 = std::sqrt(4.0 * k * k * R * R - 1.0) / (2.0 * k);
+  const double kappa = 2.0 * k / std::pow(1.0 + 4.0 * k * k * t0 * t0, 1.5);
+  const double band = std::sqrt(2.0 * H / ((1.0 / R - kappa) * (1.0 + 4.0 * k * k * t0 * t0)));
+  std::size_t unreachable = 0, reachable = 0, missed = 0, cut = 0;
+  double leastUnreachable = kInf, mostReachable = -kInf, leastMissed = kInf, widestMiss = 0.0;
+  for (std::size_t j = 0; j < report.design.rows; ++j) {
+    for (std::size_t i = 0; i < report.design.columns; ++i) {
+      const std::size_t index = j * report.design.columns + i;
+      const Vec2 p = report.design.point(i, j);
+      if (report.design.z[index] == -kInf || p.y < R + H + 0.01 || p.y > 2.0 - R - H - 0.01) continue;
+      const double scallop = std::max(0.0, report.stock.z[index] - report.design.z[index]) * report.designNormalZ[index];
+      if (scallop <= H) {
+        ++cut;
+        continue;
+      }
+      const double least = judge.gap(p.x, H).first;
+      const auto where = [&] { return ::testing::Message() << "(" << p.x << ", " << p.y << ")"; };
+      if (!report.unreachable[index]) {
+        ++reachable;
+        mostReachable = std::max(mostReachable, least);
+        EXPECT_LE(least, H + 2.1 * eps) << where() << ": classified reachable, the ball comes no nearer than " << least;
+        continue;
+      }
+      ++unreachable;
+      if (least > H) {
+        leastUnreachable = std::min(leastUnreachable, least);
+        continue;
+      }
+      ++missed;
+      leastMissed = std::min(leastMissed, least);
+      const double inside = t0 - std::abs(p.x - 1.0);  // how far inside the wedge's contact
+      widestMiss = std::max(widestMiss, inside);
+      EXPECT_GT(inside, 0.0) << where();
+      EXPECT_LT(inside, 1.5 * band) << where() << ": classified unreachable, the ball comes within " << least;
+    }
+  }
+  std::printf("[          ] valley k %g, R %g, H %g (judged away from the ends): %zu cut to H, %zu classified "
+              "reachable (largest least gap %.3g), %zu unreachable (%zu of them within H of the wedged ball: least "
+              "gap %.3g, at most %.3g inside its contact, band %.3g; the others' least gap >= %.3g); in all %zu "
+              "unreachable points (area %.4g), %zu uncut\n",
+              k, R, H, cut, reachable, mostReachable, unreachable, missed, leastMissed, widestMiss, band,
+              leastUnreachable, report.unreachablePoints, report.unreachableArea, report.uncutPoints);
+  EXPECT_GT(reachable, 100u);
+  EXPECT_GT(unreachable, 300u);
+  EXPECT_GT(cut, 100u);
+  EXPECT_LE(missed, unreachable / 10);
+}
+
+// The option and the budget, on the valley with nothing cut (the finishing stock everywhere,
+// every point above H): classifyReach = false classifies nothing and counts every point in
+// the scallop figures; maxReachChecks = 10 classifies 10 points, says the budget ran out,
+// and agrees with the full classification on the points it flags; the figures add up.
+TEST(CutSimulationReach, TheOptionAndTheBudget) {
+  const Surface surface = valley(2.0);
+  SimulationOptions options;
+  options.toolRadius = 0.5;
+  options.scallopHeight = 0.002;
+  options.resolution = 0.04;
+  options.stockAllowance = 0.05;
+  options.stockTop = 3.0;
+  const SimulationReport full = simulateCut(surface, {}, options);
+  expectReachBookkeeping(full, options.scallopHeight, "full");
+  EXPECT_EQ(full.reachChecks, full.surfacePoints + full.unreachablePoints);  // every point above H
+  EXPECT_GT(full.unreachablePoints, 100u);
+  EXPECT_FALSE(full.reachBudgetExhausted);
+
+  options.classifyReach = false;
+  const SimulationReport off = simulateCut(surface, {}, options);
+  EXPECT_EQ(off.reachChecks, 0u);
+  EXPECT_EQ(off.unreachablePoints, 0u);
+  EXPECT_EQ(off.unreachableArea, 0.0);
+  EXPECT_EQ(off.maxUnreachableScallop, 0.0);
+  EXPECT_FALSE(off.maxUnreachableAt.has_value());
+  EXPECT_FALSE(off.reachBudgetExhausted);
+  EXPECT_EQ(std::count(off.unreachable.begin(), off.unreachable.end(), 1), 0);
+  EXPECT_EQ(off.uncutPoints, full.uncutPoints + full.unreachablePoints);
+  EXPECT_GE(off.maxScallop, full.maxScallop);
+  EXPECT_NEAR(off.maxScallop, std::max(full.maxScallop, full.maxUnreachableScallop), 1e-15);
+
+  options.classifyReach = true;
+  options.maxReachChecks = 10;
+  const SimulationReport budget = simulateCut(surface, {}, options);
+  EXPECT_EQ(budget.reachChecks, 10u);
+  EXPECT_TRUE(budget.reachBudgetExhausted);
+  EXPECT_LE(budget.unreachablePoints, 10u);
+  EXPECT_EQ(budget.uncutPoints + budget.unreachablePoints, off.uncutPoints);
+  for (std::size_t i = 0; i < budget.unreachable.size(); ++i) {
+    if (budget.unreachable[i]) {
+      EXPECT_EQ(full.unreachable[i], 1) << i;
+    }
+  }
+  options.maxReachChecks = 0;
+  const SimulationReport none = simulateCut(surface, {}, options);
+  EXPECT_EQ(none.reachChecks, 0u);
+  EXPECT_TRUE(none.reachBudgetExhausted);
+  EXPECT_EQ(none.unreachablePoints, 0u);
+}
+
+// Where the ball touches every point from its own centre q + R n (a plane, tilted; a dome,
+// convex: it lies below each tangent plane, so the ball above the plane at q clears it),
+// nothing is unreachable, though every point is left above H and classified.
+TEST(CutSimulationReach, NothingIsUnreachableOnAPlaneOrAConvexDome) {
+  BezierPatch tilted;
+  tilted.degreeU = tilted.degreeV = 1;
+  tilted.control = {{0.0, 0.0, 0.0}, {0.0, 2.0, 0.3}, {2.0, 0.0, 1.2}, {2.0, 2.0, 1.5}};
+  BezierPatch dome;
+  dome.degreeU = dome.degreeV = 2;
+  const double c[3] = {1.0, -1.0, 1.0};  // (2u - 1)^2
+  for (int j = 0; j <= 2; ++j)
+    for (int i = 0; i <= 2; ++i) dome.control.push_back({double(j), double(i), 2.0 - 0.8 * (c[j] + c[i])});
+  for (const auto& [patch, name] : {std::pair{tilted, "plane"}, std::pair{dome, "dome"}}) {
+    for (const double R : {0.1, 0.5, 1.5}) {
+      SimulationOptions options;
+      options.toolRadius = R;
+      options.scallopHeight = 0.002;
+      options.resolution = 0.04;
+      options.stockAllowance = 0.05;
+      options.stockTop = 5.0;
+      const SimulationReport report = simulateCut(Surface{Units::inch, {patch}}, {}, options);
+      expectReachBookkeeping(report, options.scallopHeight, name);
+      EXPECT_GT(report.reachChecks, 1000u) << name << " R " << R;
+      EXPECT_EQ(report.unreachablePoints, 0u) << name << " R " << R;
+      EXPECT_EQ(report.maxUnreachableScallop, 0.0) << name << " R " << R;
+    }
+  }
 }
 
 }  // namespace
