@@ -277,19 +277,14 @@ PassLift liftPass(const SurfaceDistance& distance, const ToolPass& pass, std::si
   // the midpoint lifted, depth first so the moves come out in order.
   const double bottom = bottomOf(distance.surface(), radius);
   const double sagLength = std::sqrt(8.0 * radius * options.sagTolerance);
+  bool sagHere = false;  // the sag rule applies to the input move being refined
   auto refineLine = [&](auto&& self, Vec3 from, Vec3 to, double toLift, int halvings) -> void {
     if (lifter.segmentClear(from, to, eps)) {
-      if (options.sagTolerance > 0.0 && halvings < kEnvelopeMaxHalvings &&
+      if (sagHere && halvings < kEnvelopeMaxHalvings &&
           std::hypot(to.x - from.x, to.y - from.y) > sagLength) {
         const Vec3 middle = 0.5 * (from + to);
         const Vec3 onEnvelope = lifter.lift({middle.x, middle.y, bottom});
-        // Only a move whose ends stand on the envelope cuts along it: one with an end in the
-        // air (a link rising, crossing at its height, coming down) is left as it is.
-        const auto onTheEnvelope = [&](Vec3 p) {
-          return lifter.lift({p.x, p.y, bottom}).z >= p.z - options.sagTolerance;
-        };
-        if (onEnvelope.z > bottom && onEnvelope.z < middle.z - options.sagTolerance &&
-            onTheEnvelope(from) && onTheEnvelope(to)) {
+        if (onEnvelope.z > bottom && onEnvelope.z < middle.z - options.sagTolerance) {
           self(self, from, onEnvelope, kInserted, halvings + 1);
           self(self, onEnvelope, to, toLift, halvings + 1);
           return;
@@ -311,7 +306,14 @@ PassLift liftPass(const SurfaceDistance& distance, const ToolPass& pass, std::si
 
   Vec3 at = pass.start;       // the input position
   Vec3 liftedAt = lifted.start;
+  // The input moves the sag rule applies to (see EnvelopeOptions::sagMoves).
+  std::size_t sagFirst = 0, sagLast = pass.moves.size();
+  if (passIndex < options.sagMoves.size()) {
+    sagFirst = std::min(options.sagMoves[passIndex].first, pass.moves.size());
+    sagLast = std::min(options.sagMoves[passIndex].second, pass.moves.size());
+  }
   for (std::size_t m = 0; m < pass.moves.size(); ++m) {
+    sagHere = options.sagTolerance > 0.0 && m >= sagFirst && m < sagLast;
     const ToolMove& move = pass.moves[m];
     if (!isFinite(move.end) || (move.kind == MoveKind::arc && !isFinite(move.center))) {
       throw Error(fmt::format("drop envelope: pass {}, move {}: not finite", passIndex, m));
@@ -510,6 +512,8 @@ class BandDropper {
     if (!(radius > 0.0) || !std::isfinite(radius))
       throw Error(fmt::format("{}: the tool radius must be positive and finite, got {}", what, radius));
     const Surface& surface = distance.surface();
+    if (!(options.depthTolerance >= 0.0) || !std::isfinite(options.depthTolerance))
+      throw Error(fmt::format("{}: the depth tolerance must be finite and >= 0, got {}", what, options.depthTolerance));
     const double eps = options.depthTolerance > 0.0 ? options.depthTolerance : 1e-6 * surfaceScale(surface);
     if (!(eps < radius))
       throw Error(fmt::format("{}: the depth tolerance {} must be below the tool radius {}", what, eps, radius));
@@ -570,6 +574,8 @@ struct DropCutter::State {
 DropCutter::DropCutter(const SurfaceDistance& distance, double radius, const EnvelopeOptions& options) {
   if (!(radius > 0.0) || !std::isfinite(radius))
     throw Error(fmt::format("drop cutter: the tool radius must be positive and finite, got {}", radius));
+  if (!(options.depthTolerance >= 0.0) || !std::isfinite(options.depthTolerance))
+    throw Error(fmt::format("drop cutter: the depth tolerance must be finite and >= 0, got {}", options.depthTolerance));
   const double eps = options.depthTolerance > 0.0 ? options.depthTolerance : 1e-6 * surfaceScale(distance.surface());
   if (!(eps < radius))
     throw Error(fmt::format("drop cutter: the depth tolerance {} must be below the tool radius {}", eps, radius));

@@ -483,6 +483,11 @@ void liftRasterPaths(const SurfaceDistance& distance, const RasterOptions& optio
   envelope.depthTolerance = options.depthTolerance;
   envelope.stretchThreshold = options.stretchThreshold;
   envelope.sagTolerance = options.sagTolerance;
+  // The sag rule on the cutting moves only: after the link and the entry, before the exit.
+  for (std::size_t p = 0; p < out.passes.size(); ++p) {
+    const RasterPass& info = out.passes[p];
+    envelope.sagMoves.emplace_back(info.linkMoves + info.entryMoves, out.path.passes[p].moves.size() - info.exitMoves);
+  }
   std::vector<std::vector<std::size_t>> moveMap;
   out.path = liftToDropEnvelope(distance, out.path, envelope, out.envelope, &moveMap);
   out.stats.centreLength = 0.0;

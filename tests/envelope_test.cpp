@@ -1270,15 +1270,12 @@ TEST(DropEnvelope, SagToleranceSplitsMovesWhereTheEnvelopeSags) {
   }
 }
 
-// Found while writing the test above, kept disabled (it fails): the sag rule applies to every
-// straight move, so with a sag tolerance the raster's links, which rise to their link height
-// L, cross at L and come down (raster.hpp's contract; RasterPass::linkHeight), have the
-// crossing's midpoint lowered onto the envelope and each half split again: the link dives to
-// the surface between the passes. Measured (bestAngle, R = 0.25 in, H = 0.001 in, s = H / 4 as
-// the CLI passes): paper-1 86 of 86 links with vertices below L (by up to 0.229 in), their
-// moves 258 -> 863; paper-2 96 of 122 (up to 0.268 in). Here (spacing 0.3 in): all 13 links,
-// 694 link vertices below L (the first, 0.498 in against L = 0.696 in).
-TEST(DropEnvelope, DISABLED_RasterLinksStayAtTheirHeightWithASagTolerance) {
+// Found while writing the test above: the sag rule applied to every straight move, so with a
+// sag tolerance the raster's links, which rise to their link height L, cross at L and come
+// down (raster.hpp's contract; RasterPass::linkHeight), had the crossing's midpoint lowered
+// onto the envelope: the link dived to the surface between the passes (paper-1: 86 of 86
+// links, by up to 0.229 in). The rule now splits only moves whose ends stand on the envelope.
+TEST(DropEnvelope, RasterLinksStayAtTheirHeightWithASagTolerance) {
   const Surface s = exampleSurface("paper-1");
   RasterOptions o;
   o.bestAngle = true;

@@ -35,10 +35,11 @@
 //           the arc lies within s of its chord); otherwise it becomes straight moves through
 //           points of the arc, lifted and refined as lines are;
 //         - with a sag tolerance s > 0, a proven straight move longer than sqrt(8 R s)
-//           whose ends both stand within s of the envelope and whose midpoint lies more
-//           than s above it is split there (the midpoint lowered onto the envelope), so that
-//           no cutting move leaves more than about s of material where the envelope sags
-//           between its ends; moves with an end in the air (links) are left alone;
+//           horizontally whose midpoint lies more than s above the envelope is split there
+//           (the midpoint lowered onto the envelope), so that no cutting move leaves more
+//           than about s of material where the envelope sags between its ends; only the
+//           input moves EnvelopeOptions::sagMoves names (every move by default: a strategy
+//           names its cutting moves, so that its links keep their height);
 //         - a move not proven is halved, its midpoint lifted as a vertex, and each half tried
 //           again, at most kEnvelopeMaxHalvings times, then kept with its depth unproven
 //           (counted in EnvelopeReport::unprovenMoves; none on the paper's surfaces or the
@@ -66,6 +67,7 @@
 #include <cstddef>
 #include <limits>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "scallop/gouge.hpp"
@@ -89,13 +91,17 @@ struct EnvelopeOptions {
   std::size_t maxCellsPerProof = 100'000;
   /// Threads lifting passes at once; 0: every core. The result is the same for any number.
   std::size_t threads = 0;
-  /// > 0: a straight move longer than sqrt(8 R sagTolerance), both of whose ends stand within
-  /// this of the envelope, and whose midpoint lies more than
-  /// this above the envelope there (its drop-cutter height) is split there, the midpoint
-  /// lowered onto the envelope, and each half tried again (within kEnvelopeMaxHalvings):
-  /// where the envelope sags between two lifted vertices (a valley across the pass) a
-  /// straight move would leave that much material. 0: moves are only split when not clear.
+  /// > 0: a straight move longer than sqrt(8 R sagTolerance) horizontally whose midpoint lies
+  /// more than this above the envelope there (its drop-cutter height) is split there, the
+  /// midpoint lowered onto the envelope, and each half tried again (within
+  /// kEnvelopeMaxHalvings): where the envelope sags between two lifted vertices (a valley
+  /// across the pass) a straight move would leave that much material. 0: moves are only
+  /// split when not clear.
   double sagTolerance = 0.0;
+  /// Per pass, the input moves [first, last) the sag rule applies to (a pass beyond the end
+  /// of the list: all its moves): the cutting moves, not the links, which stand above the
+  /// surface by design and must keep their height.
+  std::vector<std::pair<std::size_t, std::size_t>> sagMoves;
 };
 
 /// A run of consecutive output vertices of one pass lifted by more than the threshold: an
@@ -135,7 +141,8 @@ ToolPath liftToDropEnvelope(const SurfaceDistance& distance, const ToolPath& pat
 /// within eps / 4 from which the vertical segment up to Ztop is proven R - eps / 2 clear;
 /// -infinity where no surface point lies within R of the vertical line). The last contact
 /// seeds the next point's Newton solve: neighbouring points cost about one proof each. Not
-/// thread-safe (one per thread). Errors: R not positive and finite, eps >= R.
+/// thread-safe (one per thread). Errors: R not positive and finite, a depth tolerance
+/// negative or not finite, eps >= R.
 class DropCutter {
  public:
   DropCutter(const SurfaceDistance& distance, double radius, const EnvelopeOptions& options = {});
