@@ -383,8 +383,7 @@ TEST_F(PlanAcceptance, Paper2RasterQuarterInchBall) { expectFinished("paper-2", 
 // surface's corners a little more than H is left where the reach classification (a ball at
 // the point's own offset, cut_simulation.hpp) counts the point reachable but no pass gets
 // there: measured 1.40 H on 0.0009 in^2 (contour) and 2.05 H on 0.003 in^2 (raster), of the
-// 9 in^2. The small ball on the raster leaves 1.02 H on a few grid points. Pinned here so that
-// they can only shrink.
+// 9 in^2. Pinned here so that they can only shrink.
 TEST_F(PlanAcceptance, Paper2InchBallReportsThePocketsBeyondItsReach) {
   for (const char* strategy : {"contour", "raster"}) {
     const PlanVerdict v = plan("paper-2", strategy, 1.0);
@@ -395,6 +394,10 @@ TEST_F(PlanAcceptance, Paper2InchBallReportsThePocketsBeyondItsReach) {
   }
 }
 
+// The simulator measures the scallop as the vertical gap times |n_z|, exact on planes: with a
+// 0.05 in ball on paper-2's 43-degree flanks it reads 1.02 H at two grid points beside the
+// edges, where the nearest ball of the program (distance to its moves, by hand) stands
+// 0.80 H from the surface point. Allowed 5 % over H for that reason.
 TEST_F(PlanAcceptance, Paper2RasterSmallBall) {
   const PlanVerdict v = plan("paper-2", "raster", 0.05);
   EXPECT_LE(v.maxGouge, v.gougeTolerance);
