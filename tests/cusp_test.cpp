@@ -808,6 +808,18 @@ double judgeRasterScallop(const Surface& s, const RasterBalls& balls,
 
 class CuspCentrePlanes : public ::testing::TestWithParam<std::tuple<const char*, double, double>> {};
 
+// The adaptive offsets for raster (centre planes) and, to compare, the contact-plane model's.
+std::pair<scallop::AdaptiveOffsets, scallop::AdaptiveOffsets> centreAndContactOffsets(
+    const Surface& s, const Vec3& e, double radius, double h) {
+  scallop::CuspOptions cusp;
+  cusp.toolRadius = radius;
+  cusp.scallopHeight = h;
+  cusp.centrePlanes = true;
+  scallop::AdaptiveOffsets centre = scallop::adaptivePlaneOffsets(s, e, cusp);
+  cusp.centrePlanes = false;
+  return {std::move(centre), scallop::adaptivePlaneOffsets(s, e, cusp)};
+}
+
 // The adaptive centre-plane offsets (CuspOptions::centrePlanes) keep the real raster scallop
 // below H: planes e . c = w at a feed angle, their passes on the drop envelope, and the
 // scallop the swept balls leave (RasterBalls, judgeRasterScallop). The judge can misstate the
@@ -822,13 +834,7 @@ TEST_P(CuspCentrePlanes, AdaptiveRasterScallopStaysBelowH) {
   const double h = radius == 0.25 ? 0.001 : 0.004;
   const Surface s = scallop::exampleSurface(name);
   const Vec3 e{-std::sin(angle), std::cos(angle), 0.0};
-  scallop::CuspOptions cusp;
-  cusp.toolRadius = radius;
-  cusp.scallopHeight = h;
-  cusp.centrePlanes = true;
-  const scallop::AdaptiveOffsets a = scallop::adaptivePlaneOffsets(s, e, cusp);
-  cusp.centrePlanes = false;
-  const scallop::AdaptiveOffsets contact = scallop::adaptivePlaneOffsets(s, e, cusp);
+  const auto [a, contact] = centreAndContactOffsets(s, e, radius, h);
   double model = 0.0;
   for (const double c : a.worstCusp) model = std::max(model, c);
   const RasterBalls balls(s, e, radius, 10.0 * h, a.offsets, radius / 64.0);
@@ -873,13 +879,7 @@ TEST(CuspCentrePlanesCylinder, ModelAndJudgeAgainstTheClosedForm) {
   for (const bool convex : {true, false}) {
     const Surface s = cylinder(rho, half, convex);
     const Vec3 e{1.0, 0.0, 0.0};
-    scallop::CuspOptions cusp;
-    cusp.toolRadius = radius;
-    cusp.scallopHeight = h;
-    cusp.centrePlanes = true;
-    const scallop::AdaptiveOffsets a = scallop::adaptivePlaneOffsets(s, e, cusp);
-    cusp.centrePlanes = false;
-    const scallop::AdaptiveOffsets contact = scallop::adaptivePlaneOffsets(s, e, cusp);
+    const auto [a, contact] = centreAndContactOffsets(s, e, radius, h);
     const double offsetRadius = convex ? rho + radius : rho - radius;
     const double reach = offsetRadius * half / rho;  // |w| of a centre touching the edge x = +-half
     const auto closedForm = [&](double w0, double w1) {

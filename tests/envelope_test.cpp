@@ -1274,7 +1274,8 @@ TEST(DropEnvelope, SagToleranceSplitsMovesWhereTheEnvelopeSags) {
 // sag tolerance the raster's links, which rise to their link height L, cross at L and come
 // down (raster.hpp's contract; RasterPass::linkHeight), had the crossing's midpoint lowered
 // onto the envelope: the link dived to the surface between the passes (paper-1: 86 of 86
-// links, by up to 0.229 in). The rule now splits only moves whose ends stand on the envelope.
+// links, by up to 0.229 in). The strategies now name their cutting moves
+// (EnvelopeOptions::sagMoves), and the rule applies to those only.
 TEST(DropEnvelope, RasterLinksStayAtTheirHeightWithASagTolerance) {
   const Surface s = exampleSurface("paper-1");
   RasterOptions o;
