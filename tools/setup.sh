@@ -14,7 +14,7 @@ jobs="${JOBS:-$(nproc)}"
 
 # Debian packages scallop builds with (headers, CMake configs, test and bench frameworks).
 packages=(build-essential cmake pkg-config nlohmann-json3-dev libfmt-dev libcli11-dev libboost-dev
-          libpolyclipping-dev
+          libpolyclipping-dev libqhull-dev
           libgtest-dev libgmock-dev libbenchmark-dev)
 # The tests check the G-code writer with LinuxCNC's own interpreter, rs274 (gcode_test.cpp
 # fails without it). It runs headless; with --no-install-recommends it still pulls in about
