@@ -4,6 +4,8 @@
 // two SVG figures. Every output is computed into memory first and the files are then written
 // all or nothing, so a failed run leaves no output behind (not even the --svg-dir directory).
 
+#include <cctype>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -21,6 +23,8 @@
 #include "output_directory.hpp"
 #include "scallop/error.hpp"
 #include "scallop/file_output.hpp"
+#include "scallop/mesh.hpp"
+#include "scallop/mesh_slicing.hpp"
 #include "scallop/optimal_slicing.hpp"
 #include "scallop/orient_output.hpp"
 #include "scallop/surface.hpp"
@@ -47,7 +51,61 @@ struct OrientOptions {
   std::string svgDir;     // --svg-dir DIR
   bool noCertify = false;  // --no-certify
   bool latticeSeeds = false;  // --lattice-seeds
+  std::string units;      // --units in|mm: an STL mesh's (STL has none)
+  bool dropZeroArea = false;  // --drop-zero-area: an STL mesh's zero-area triangles
 };
+
+// Where the JSON goes: --json, or standard output when no output is named at all.
+std::string jsonDestination(const OrientOptions& options) {
+  if (!options.jsonPath.empty()) return options.jsonPath;
+  return options.svgDir.empty() ? std::string(kStandardStream) : std::string();
+}
+
+// A mesh by its name: .stl in any case.
+bool isStl(const std::string& path) {
+  if (path.size() < 4) return false;
+  std::string tail = path.substr(path.size() - 4);
+  for (char& c : tail) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return tail == ".stl";
+}
+
+// `orient` on an STL mesh (mesh_slicing.hpp): the largest empty cap of the +-facet normals.
+void runOrientMesh(const OrientOptions& options) {
+  const std::string& path = options.surface.input;
+  const auto reject = [&](bool given, const char* option, const char* why) {
+    if (given) throw Error(fmt::format("{}: {} {}; not for a mesh", path, option, why));
+  };
+  reject(!options.surface.patches.empty(), "--patches", "selects Bezier patches");
+  reject(!options.tolerance.empty(), "--tolerance", "is the polygonal Gauss map's (a mesh's is exact)");
+  reject(!options.svgDir.empty(), "--svg-dir", "draws a surface's Gauss map");
+  reject(options.noCertify || options.latticeSeeds, "--no-certify/--lattice-seeds", "apply to Bezier surfaces");
+  StlOptions stl;
+  stl.units = options.units == "in" ? Units::inch : Units::millimetre;
+  stl.dropZeroArea = options.dropZeroArea;
+  const auto start = std::chrono::steady_clock::now();
+  const StlMesh mesh = [&] {
+    try {
+      return readStl(path, stl);
+    } catch (const Error& e) {
+      if (!stl.dropZeroArea && std::string(e.what()).find("zero area") != std::string::npos)
+        throw Error(fmt::format("{}; --drop-zero-area skips such triangles", e.what()));
+      throw;
+    }
+  }();
+  const MeshSlicing result = optimalMeshSlicing(mesh.mesh);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const std::string jsonPath = jsonDestination(options);
+  writeOutputs({{jsonPath, meshOrientationToJson(result, mesh, path, seconds)}}, "");
+  if (jsonPath != kStandardStream) {
+    fmt::print(stderr,
+               "scallop: {}: {} triangles ({} STL{}), {} distinct normals: N* = ({:.6f}, {:.6f}, {:.6f}), alpha* = "
+               "{:.4f} deg{}; {:.3f} s -> {}\n",
+               path, result.triangles, mesh.format == StlFormat::binary ? "binary" : "ASCII",
+               mesh.zeroAreaDropped > 0 ? fmt::format(", {} of zero area dropped", mesh.zeroAreaDropped) : std::string(),
+               result.distinctNormals, result.normal.x, result.normal.y, result.normal.z, toDegrees(result.alphaRad),
+               result.greatCircle ? " (every normal on one great circle: its pole)" : "", seconds, jsonPath);
+  }
+}
 
 // Checks the combination of options, which CLI11 cannot express.
 void checkOptions(const OrientOptions& options) {
@@ -79,11 +137,6 @@ double parseTolerance(const std::string& text) {
   return degrees;
 }
 
-// Where the JSON goes: --json, or standard output when no output is named at all.
-std::string jsonDestination(const OrientOptions& options) {
-  if (!options.jsonPath.empty()) return options.jsonPath;
-  return options.svgDir.empty() ? std::string(kStandardStream) : std::string();
-}
 
 std::string certificateSummary(const OptimalSlicing& result, bool certify) {
   if (!certify) return "not certified (--no-certify)";
@@ -128,6 +181,12 @@ void printSummary(const std::string& source, const OptimalSlicing& result, bool 
 
 void runOrient(const OrientOptions& options) {
   checkOptions(options);
+  if (isStl(options.surface.input)) {
+    runOrientMesh(options);
+    return;
+  }
+  if (!options.units.empty() || options.dropZeroArea)
+    throw Error("--units and --drop-zero-area are for STL meshes (a .stl file); a surface's units are in its file");
   OptimalSlicingOptions slicingOptions;  // the library's default tolerance unless given
   double toleranceDeg = defaultToleranceDeg();
   if (!options.tolerance.empty()) {
@@ -182,10 +241,13 @@ void addOrientCommand(CLI::App& app) {
       "When the Gauss map leaves no direction free, 'no slicing direction exists' is said only "
       "with a proof that the normals cover the sphere; otherwise the best direction found, "
       "certified.\n"
+      "A .stl file (binary or ASCII) is a triangle mesh: N* is then the centre of the largest "
+      "spherical cap free of its +-facet normals (their convex hull's facet nearest the origin), "
+      "alpha* the least angle to them; JSON only.\n"
       "Example: scallop orient --example teapot-body --json out.json --svg-dir figs");
 
   addSurfaceSourceOptions(*orient, options->surface,
-                          "surface file (JSON or .bpt, Bezier patches); - reads standard input",
+                          "surface file (JSON or .bpt, Bezier patches; .stl: a triangle mesh); - reads standard input",
                           "use a built-in example surface instead");
   orient
       ->add_option("--tolerance", options->tolerance,
@@ -209,6 +271,13 @@ void addOrientCommand(CLI::App& app) {
   orient->add_flag("--lattice-seeds", options->latticeSeeds,
                    "also polish from the best directions of a fixed lattice of 2,000 (a "
                    "safety net beside the medial axis; off: the paper's method alone)");
+  orient
+      ->add_option("--units", options->units,
+                   "an STL mesh's units, in or mm (default mm: STL has none)")
+      ->check(CLI::IsMember({"in", "mm"}))
+      ->type_name("UNITS");
+  orient->add_flag("--drop-zero-area", options->dropZeroArea,
+                   "an STL mesh's triangles of zero area are dropped (counted) instead of refused");
   orient->callback([options] { runOrient(*options); });
 }
 

@@ -1086,4 +1086,23 @@ std::string stereographicSvg(const OptimalSlicing& result) {
   return svg;
 }
 
+std::string meshOrientationToJson(const MeshSlicing& result, const StlMesh& mesh, const std::string& source,
+                                  double seconds) {
+  nlohmann::ordered_json document;
+  document["input"] = "mesh";
+  document["source"] = source;
+  document["format"] = mesh.format == StlFormat::binary ? "binary" : "ascii";
+  document["units"] = std::string(unitsName(mesh.mesh.units));
+  document["triangles_read"] = mesh.trianglesRead;
+  document["zero_area_dropped"] = mesh.zeroAreaDropped;
+  document["triangles"] = result.triangles;
+  document["distinct_normals"] = result.distinctNormals;
+  document["hull_facets"] = result.hullFacets;
+  document["great_circle"] = result.greatCircle;
+  document["normal"] = {result.normal.x, result.normal.y, result.normal.z};
+  document["alpha_deg"] = toDegrees(result.alphaRad);
+  document["seconds"] = seconds;
+  return json::format(document);
+}
+
 }  // namespace scallop

@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <numbers>
 #include <string>
@@ -16,6 +18,8 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_fixture.hpp"
+#include "scallop/mesh.hpp"
+#include "scallop/mesh_slicing.hpp"
 #include "scallop/optimal_slicing.hpp"
 #include "scallop/surface.hpp"
 
@@ -223,6 +227,87 @@ TEST_F(OrientCli, Help) {
     EXPECT_NE(help.out.find(part), std::string::npos) << part;
   }
   EXPECT_TRUE(listing().empty());
+}
+
+// ---- STL meshes: `orient part.stl` ----
+
+// A binary STL of triangles with the given normals (each on its own, placed apart), written
+// here: 80-byte header, count, 50 bytes per triangle, little-endian floats.
+std::string binaryStlOf(const std::vector<std::array<float, 3>>& normals, bool zeroAreaToo = false) {
+  std::string out(80, ' ');
+  const auto u32 = [&](std::uint32_t x) {
+    for (int i = 0; i < 4; ++i) out.push_back(static_cast<char>((x >> (8 * i)) & 0xff));
+  };
+  const auto f32 = [&](float f) {
+    std::uint32_t x = 0;
+    std::memcpy(&x, &f, 4);
+    u32(x);
+  };
+  u32(static_cast<std::uint32_t>(normals.size() + (zeroAreaToo ? 1 : 0)));
+  const auto triangle = [&](const std::array<std::array<float, 3>, 3>& v) {
+    for (int k = 0; k < 3; ++k) f32(0.0f);
+    for (const auto& p : v)
+      for (const float c : p) f32(c);
+    out += std::string(2, '\0');
+  };
+  float x = 0.0f;
+  for (const auto& n : normals) {
+    // Two edges orthogonal to n: (b - a) x (c - a) points along n.
+    const std::array<float, 3> helper = std::abs(n[0]) < 0.9f ? std::array<float, 3>{1, 0, 0} : std::array<float, 3>{0, 1, 0};
+    const std::array<float, 3> u = {n[1] * helper[2] - n[2] * helper[1], n[2] * helper[0] - n[0] * helper[2],
+                                    n[0] * helper[1] - n[1] * helper[0]};
+    const std::array<float, 3> v = {n[1] * u[2] - n[2] * u[1], n[2] * u[0] - n[0] * u[2], n[0] * u[1] - n[1] * u[0]};
+    triangle({{{x, 0, 0}, {x + u[0], u[1], u[2]}, {x + v[0], v[1], v[2]}}});
+    x += 10.0f;
+  }
+  if (zeroAreaToo) triangle({{{0, 0, 0}, {1, 1, 1}, {2, 2, 2}}});
+  return out;
+}
+
+const std::vector<std::array<float, 3>> kSomeNormals = {
+    {0.1f, 0.2f, 1.0f}, {-0.3f, 0.1f, 0.9f}, {0.2f, -0.4f, 0.8f}, {0.5f, 0.5f, 0.6f}, {-0.2f, -0.3f, 1.0f}};
+
+TEST_F(OrientCli, AnStlMeshGivesTheLibrarysDirectionAsJson) {
+  const std::string bytes = binaryStlOf(kSomeNormals);
+  write("part.stl", bytes);
+  const RunResult result = run("orient part.stl --json out.json");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  EXPECT_NE(result.err.find("5 triangles (binary STL)"), std::string::npos) << result.err;
+  const Json doc = Json::parse(readFile(workDir_ / "out.json"));
+  const scallop::StlMesh mesh = scallop::parseStl(bytes, "part.stl", {});
+  const scallop::MeshSlicing expected = scallop::optimalMeshSlicing(mesh.mesh);
+  EXPECT_EQ(doc["input"], "mesh");
+  EXPECT_EQ(doc["format"], "binary");
+  EXPECT_EQ(doc["units"], "mm");
+  EXPECT_EQ(doc["triangles"].get<std::size_t>(), 5u);
+  // Full precision: the same doubles as the library's.
+  EXPECT_EQ(doc["normal"][0].get<double>(), expected.normal.x);
+  EXPECT_EQ(doc["normal"][1].get<double>(), expected.normal.y);
+  EXPECT_EQ(doc["normal"][2].get<double>(), expected.normal.z);
+  EXPECT_EQ(doc["alpha_deg"].get<double>(), expected.alphaRad * 180.0 / std::numbers::pi);
+  // JSON on standard output when no output is named; --units in recorded.
+  const RunResult piped = run("orient part.stl --units in");
+  ASSERT_EQ(piped.exitCode, 0) << piped.err;
+  EXPECT_EQ(Json::parse(piped.out)["units"], "in");
+}
+
+TEST_F(OrientCli, BadStlMeshesFailCleanly) {
+  write("empty.stl", "");
+  expectCleanFailure(run("orient empty.stl --json out.json"), {"empty.stl", "empty"}, "empty.stl");
+  std::filesystem::remove(workDir_ / "empty.stl");
+  write("z.stl", binaryStlOf(kSomeNormals, true));
+  expectCleanFailure(run("orient z.stl --json out.json"), {"z.stl", "triangle 5 has zero area", "--drop-zero-area"},
+                     "z.stl");
+  expectCleanFailure(run("orient z.stl --svg-dir figs"), {"z.stl", "--svg-dir", "not for a mesh"}, "z.stl");
+  expectCleanFailure(run("orient z.stl --patches 0"), {"--patches", "not for a mesh"}, "z.stl");
+  const RunResult dropped = run("orient z.stl --drop-zero-area --json out.json");
+  ASSERT_EQ(dropped.exitCode, 0) << dropped.err;
+  const Json doc = Json::parse(readFile(workDir_ / "out.json"));
+  EXPECT_EQ(doc["zero_area_dropped"].get<std::size_t>(), 1u);
+  EXPECT_EQ(doc["triangles"].get<std::size_t>(), 5u);
+  std::filesystem::remove(workDir_ / "out.json");
+  std::filesystem::remove(workDir_ / "z.stl");
+  expectCleanFailure(run("orient --example paper-1 --units in"), {"--units", "STL"}, nullptr);
 }
 
 }  // namespace

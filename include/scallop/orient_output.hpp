@@ -49,6 +49,8 @@
 #include <numbers>
 #include <string>
 
+#include "scallop/mesh.hpp"
+#include "scallop/mesh_slicing.hpp"
 #include "scallop/optimal_slicing.hpp"
 
 namespace scallop {
@@ -58,6 +60,13 @@ constexpr double toDegrees(double radians) { return radians * (180.0 / std::numb
 
 /// The JSON form of `result` (see above); `toleranceDeg` is recorded as "tolerance_deg".
 std::string orientationToJson(const OptimalSlicing& result, double toleranceDeg);
+
+/// The JSON form of a mesh's optimal slicing (mesh_slicing.hpp): {"input": "mesh", "source",
+/// "format": "binary"|"ascii", "units", "triangles_read", "zero_area_dropped", "triangles" (of
+/// positive area), "distinct_normals", "hull_facets", "great_circle", "normal": [x, y, z],
+/// "alpha_deg", "seconds"}; numbers round-trip exactly.
+std::string meshOrientationToJson(const MeshSlicing& result, const StlMesh& mesh, const std::string& source,
+                                  double seconds);
 
 /// The symmetrized Gauss map and the optimal circle on the unit sphere (see above).
 std::string gaussMapSphereSvg(const OptimalSlicing& result);
