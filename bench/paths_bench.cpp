@@ -96,26 +96,32 @@ void BM_PlanRaster(benchmark::State& state) {
   state.SetLabel(surfaceName(state));
 }
 
+// The contour plan's path (N*, the paper's spacing for H), lifted or not.
+scallop::ToolPath contourPlanPath(const scallop::Surface& surface, bool dropEnvelope = true) {
+  const scallop::OptimalSlicing orientation = scallop::optimalSlicing(surface);
+  scallop::ContourOptions options;
+  options.normal = orientation.normal.z < 0.0 ? -orientation.normal : orientation.normal;
+  options.toolRadius = kToolRadius;
+  options.spacing = scallop::spacingForScallopHeight(kToolRadius, kScallopHeight,
+                                                     orientation.certifiedAlphaRad);
+  options.dropEnvelope = dropEnvelope;
+  return scallop::contourPaths(surface, options).path;
+}
+
+// The raster plan's path (best angle, spacing for H), lifted or not.
+scallop::ToolPath rasterPlanPath(const scallop::Surface& surface, bool dropEnvelope = true) {
+  scallop::RasterOptions options;
+  options.bestAngle = true;
+  options.toolRadius = kToolRadius;
+  options.scallopHeight = kScallopHeight;
+  options.dropEnvelope = dropEnvelope;
+  return scallop::rasterPaths(surface, options).path;
+}
+
 void BM_DropEnvelope(benchmark::State& state) {
   const scallop::Surface surface = scallop::exampleSurface(surfaceName(state));
-  scallop::ToolPath path;
-  if (state.range(1) == 0) {
-    const scallop::OptimalSlicing orientation = scallop::optimalSlicing(surface);
-    scallop::ContourOptions options;
-    options.normal = orientation.normal.z < 0.0 ? -orientation.normal : orientation.normal;
-    options.toolRadius = kToolRadius;
-    options.spacing = scallop::spacingForScallopHeight(kToolRadius, kScallopHeight,
-                                                       orientation.certifiedAlphaRad);
-    options.dropEnvelope = false;
-    path = scallop::contourPaths(surface, options).path;
-  } else {
-    scallop::RasterOptions options;
-    options.bestAngle = true;
-    options.toolRadius = kToolRadius;
-    options.scallopHeight = kScallopHeight;
-    options.dropEnvelope = false;
-    path = scallop::rasterPaths(surface, options).path;
-  }
+  const scallop::ToolPath path =
+      state.range(1) == 0 ? contourPlanPath(surface, false) : rasterPlanPath(surface, false);
   const scallop::SurfaceDistance distance(surface);
   scallop::EnvelopeReport report;
   for (auto _ : state) {
@@ -144,23 +150,8 @@ void BM_PlaneSection(benchmark::State& state) {
   state.SetLabel(surfaceName(state));
 }
 
-scallop::ToolPath contourPlanPath(const scallop::Surface& surface) {
-  const scallop::OptimalSlicing orientation = scallop::optimalSlicing(surface);
-  scallop::ContourOptions options;
-  options.normal = orientation.normal.z < 0.0 ? -orientation.normal : orientation.normal;
-  options.toolRadius = kToolRadius;
-  options.spacing = scallop::spacingForScallopHeight(kToolRadius, kScallopHeight,
-                                                     orientation.certifiedAlphaRad);
-  return scallop::contourPaths(surface, options).path;
-}
 
-scallop::ToolPath rasterPlanPath(const scallop::Surface& surface) {
-  scallop::RasterOptions options;
-  options.bestAngle = true;
-  options.toolRadius = kToolRadius;
-  options.scallopHeight = kScallopHeight;
-  return scallop::rasterPaths(surface, options).path;
-}
+
 
 void linkBenchmark(benchmark::State& state, const scallop::Surface& surface,
                    const scallop::ToolPath& path) {

@@ -486,13 +486,18 @@ void designHeights(const Surface& surface, HeightGrid& grid, std::vector<double>
   }
 }
 
+// The grid points within R (horizontally) of a move's box: the only ones it can lower.
+std::pair<IndexRange, IndexRange> pointsNear(const MoveShape& shape, double toolRadius, const HeightGrid& stock) {
+  return {indexRange(shape.lo().x - toolRadius, shape.hi().x + toolRadius, stock.x0, stock.spacing, stock.columns),
+          indexRange(shape.lo().y - toolRadius, shape.hi().y + toolRadius, stock.y0, stock.spacing, stock.rows)};
+}
+
 double sweepEvaluations(const std::vector<SweptMove>& moves, double toolRadius, const HeightGrid& stock) {
   double total = 0.0;
   for (std::size_t m = 0; m < moves.size(); ++m) {
     requireMoveFinite(moves[m], m);
     const MoveShape shape(moves[m], toolRadius);
-    const IndexRange is = indexRange(shape.lo().x - toolRadius, shape.hi().x + toolRadius, stock.x0, stock.spacing, stock.columns);
-    const IndexRange js = indexRange(shape.lo().y - toolRadius, shape.hi().y + toolRadius, stock.y0, stock.spacing, stock.rows);
+    const auto [is, js] = pointsNear(shape, toolRadius, stock);
     if (is.empty() || js.empty()) continue;
     total += static_cast<double>(is.hi - is.lo + 1) * static_cast<double>(js.hi - js.lo + 1);
   }
@@ -506,8 +511,7 @@ std::size_t sweepMoves(const std::vector<SweptMove>& moves, double toolRadius, H
   for (std::size_t m = 0; m < moves.size(); ++m) {
     requireMoveFinite(moves[m], m);
     const MoveShape shape(moves[m], toolRadius);
-    const IndexRange is = indexRange(shape.lo().x - toolRadius, shape.hi().x + toolRadius, stock.x0, stock.spacing, stock.columns);
-    const IndexRange js = indexRange(shape.lo().y - toolRadius, shape.hi().y + toolRadius, stock.y0, stock.spacing, stock.rows);
+    const auto [is, js] = pointsNear(shape, toolRadius, stock);
     if (is.empty() || js.empty()) continue;
     const double floor = shape.lo().z - toolRadius;  // no point of the swept ball is lower
     double most = 0.0;

@@ -508,7 +508,7 @@ class BandDropper {
  public:
   BandDropper(const SurfaceDistance& distance, double radius, const RunOnBand& band,
               const EnvelopeOptions& options, const char* what)
-      : distance_(distance), radius_(radius), band_(band) {
+      : distance_(distance), band_(band) {
     if (!(radius > 0.0) || !std::isfinite(radius))
       throw Error(fmt::format("{}: the tool radius must be positive and finite, got {}", what, radius));
     const Surface& surface = distance.surface();
@@ -543,7 +543,6 @@ class BandDropper {
 
  private:
   const SurfaceDistance& distance_;
-  double radius_;
   RunOnBand band_;
   double bottom_ = 0.0;
   std::size_t proofs_ = 0;
@@ -563,9 +562,9 @@ void checkLine(Vec3 origin, Vec3 direction, double step, double length, const ch
 }  // namespace
 
 struct DropCutter::State {
-  State(const SurfaceDistance& distance, double radius, double eps)
+  State(const SurfaceDistance& distance, double radius, double eps, std::size_t maxCells)
       : bottom(bottomOf(distance.surface(), radius)),
-        lifter(distance, radius, eps, ballTop(distance.surface(), radius), 100'000, proofs) {}
+        lifter(distance, radius, eps, ballTop(distance.surface(), radius), maxCells, proofs) {}
   double bottom;
   std::size_t proofs = 0;
   Lifter lifter;
@@ -579,7 +578,7 @@ DropCutter::DropCutter(const SurfaceDistance& distance, double radius, const Env
   const double eps = options.depthTolerance > 0.0 ? options.depthTolerance : 1e-6 * surfaceScale(distance.surface());
   if (!(eps < radius))
     throw Error(fmt::format("drop cutter: the depth tolerance {} must be below the tool radius {}", eps, radius));
-  state_ = std::make_unique<State>(distance, radius, eps);
+  state_ = std::make_unique<State>(distance, radius, eps, options.maxCellsPerProof);
 }
 
 DropCutter::~DropCutter() = default;

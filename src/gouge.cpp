@@ -373,6 +373,31 @@ struct ByLowerBound {
   bool operator()(const Cell& a, const Cell& b) const { return a.lower > b.lower; }  // min-heap
 };
 
+// What both searches (closest point, segment clearance) do with a cell before their own
+// bounds: the rounding allowance of the contract for a cell `depth` halvings deep and queries
+// of magnitude `queryScale`; the cell's control net (in the tree, or in the scratch arena);
+// its four corners, surface points, offered to `consider`; and its axis-aligned box.
+double cellAllowance(const PatchTree& tree, int depth, double queryScale) {
+  return (3.0 * (tree.degreeU + tree.degreeV) * (depth + 1) + 16.0) * kUnitRoundoff * (tree.scale + queryScale);
+}
+
+const Vec3* cellNet(const PatchTree& tree, const Cell& cell, const std::vector<Vec3>& arena) {
+  return cell.inTree ? tree.nets[static_cast<std::size_t>(cell.depth)].data() + cell.net * tree.stride
+                     : arena.data() + cell.net;
+}
+
+template <class Consider>
+Box cornersAndBox(const PatchTree& tree, const Cell& cell, const Vec3* net, Consider&& consider) {
+  const int m = tree.degreeU;
+  const int n = tree.degreeV;
+  const double h = std::ldexp(1.0, -cell.depth);
+  consider(net[0], cell.patch, cell.u0, cell.v0);
+  consider(net[n], cell.patch, cell.u0, cell.v0 + h);
+  consider(net[m * (n + 1)], cell.patch, cell.u0 + h, cell.v0);
+  consider(net[m * (n + 1) + n], cell.patch, cell.u0 + h, cell.v0 + h);
+  return cell.inTree ? tree.boxes[static_cast<std::size_t>(cell.depth)][cell.net] : boxOf(net, tree.stride);
+}
+
 struct Scratch {
   std::vector<Cell> heap;
   std::vector<Vec3> arena;
@@ -499,34 +524,17 @@ ClosestPoint search(const Surface& surface, const std::vector<PatchTree>& trees,
     const double d = norm(q - p);
     if (d < best.distance) best = {d, patch, u, v, q};
   };
-  // The rounding allowance of the contract, for a cell `depth` halvings deep.
-  const auto allowanceOf = [&](const PatchTree& tree, int depth) {
-    return (3.0 * (tree.degreeU + tree.degreeV) * (depth + 1) + 16.0) * kUnitRoundoff *
-           (tree.scale + pScale);
-  };
-  const auto netOf = [&](const Cell& cell) -> const Vec3* {
-    const PatchTree& tree = trees[cell.patch];
-    return cell.inTree
-               ? tree.nets[static_cast<std::size_t>(cell.depth)].data() + cell.net * tree.stride
-               : arena.data() + cell.net;
-  };
   // Bounds a new cell: its corners are surface points (upper bounds); then its lower bound,
   // the axis-aligned box first (cheap, precomputed in the tree) and the separating plane
   // only if the cell survives that; then queued or set aside.
   const auto offer = [&](Cell cell) {
     ++cells;
     const PatchTree& tree = trees[cell.patch];
+    const Vec3* net = cellNet(tree, cell, arena);
+    const Box box = cornersAndBox(tree, cell, net, consider);
+    const double allowance = cellAllowance(tree, cell.depth, pScale);
     const int m = tree.degreeU;
     const int n = tree.degreeV;
-    const Vec3* net = netOf(cell);
-    const double h = std::ldexp(1.0, -cell.depth);
-    consider(net[0], cell.patch, cell.u0, cell.v0);
-    consider(net[n], cell.patch, cell.u0, cell.v0 + h);
-    consider(net[m * (n + 1)], cell.patch, cell.u0 + h, cell.v0);
-    consider(net[m * (n + 1) + n], cell.patch, cell.u0 + h, cell.v0 + h);
-    const double allowance = allowanceOf(tree, cell.depth);
-    const Box box = cell.inTree ? tree.boxes[static_cast<std::size_t>(cell.depth)][cell.net]
-                                : boxOf(net, tree.stride);
     double lower = boxDistance(box, p);
     if (lower - allowance < level()) lower = std::max(lower, separatingPlaneDistance(net, m, n, p));
     cell.lower = std::max(0.0, lower - allowance);
@@ -566,8 +574,8 @@ ClosestPoint search(const Surface& surface, const std::vector<PatchTree>& trees,
     }
     const PatchTree& tree = trees[cell.patch];
     const double convex =
-        convexLowerBound(netOf(cell), patch, cell.patch, cell.u0, cell.v0, h, best, p) -
-        allowanceOf(tree, cell.depth);
+        convexLowerBound(cellNet(tree, cell, arena), patch, cell.patch, cell.u0, cell.v0, h, best, p) -
+        cellAllowance(tree, cell.depth, pScale);
     if (convex >= level()) {
       setAside = std::min(setAside, std::max(cell.lower, convex));
       continue;
@@ -651,16 +659,6 @@ SegmentClearance segmentSearch(const std::vector<PatchTree>& trees, Vec3 a, Vec3
   arena.clear();
   SegmentClearance result;
   const double pScale = std::max(maxAbs(a), maxAbs(b));
-  const auto allowanceOf = [&](const PatchTree& tree, int depth) {
-    return (3.0 * (tree.degreeU + tree.degreeV) * (depth + 1) + 16.0) * kUnitRoundoff *
-           (tree.scale + pScale);
-  };
-  const auto netOf = [&](const Cell& cell) -> const Vec3* {
-    const PatchTree& tree = trees[cell.patch];
-    return cell.inTree
-               ? tree.nets[static_cast<std::size_t>(cell.depth)].data() + cell.net * tree.stride
-               : arena.data() + cell.net;
-  };
   // A surface point nearer than the clearance refutes it; the nearest seen is kept.
   bool violated = false;
   const auto consider = [&](Vec3 q, std::uint32_t patch, double u, double v) {
@@ -677,17 +675,11 @@ SegmentClearance segmentSearch(const std::vector<PatchTree>& trees, Vec3 a, Vec3
   const auto offer = [&](Cell cell) {
     ++result.cells;
     const PatchTree& tree = trees[cell.patch];
+    const Vec3* net = cellNet(tree, cell, arena);
+    const Box box = cornersAndBox(tree, cell, net, consider);
+    const double allowance = cellAllowance(tree, cell.depth, pScale);
     const int m = tree.degreeU;
     const int n = tree.degreeV;
-    const Vec3* net = netOf(cell);
-    const double h = std::ldexp(1.0, -cell.depth);
-    consider(net[0], cell.patch, cell.u0, cell.v0);
-    consider(net[n], cell.patch, cell.u0, cell.v0 + h);
-    consider(net[m * (n + 1)], cell.patch, cell.u0 + h, cell.v0);
-    consider(net[m * (n + 1) + n], cell.patch, cell.u0 + h, cell.v0 + h);
-    const double allowance = allowanceOf(tree, cell.depth);
-    const Box box = cell.inTree ? tree.boxes[static_cast<std::size_t>(cell.depth)][cell.net]
-                                : boxOf(net, tree.stride);
     double lower = boxSegmentDistance(box, a, b);
     if (lower - allowance < clearance) {
       lower = std::max(lower, separatingPlaneSegmentDistance(net, m, n, a, b));

@@ -130,8 +130,7 @@ MeshSlicing optimalMeshSlicing(const Mesh& mesh) {
   out.distinctNormals = normals.size();
 
   const auto finish = [&](Vec3 n) {
-    out.normal = canonical(normalized(n));
-    if (out.normal.z < 0.0) out.normal = -out.normal;
+    out.normal = canonical(normalized(n));  // z >= 0
     out.alphaRad = alphaOver(normals, out.normal);
     return out;
   };
