@@ -163,12 +163,12 @@ ContourPaths contourPaths(const Surface& surface, const ContourOptions& options)
   for (double kk = range.first; kk <= range.last; kk += 1.0) {
     const long long k = static_cast<long long>(kk);
     const double offset = offsetAt(kk);
-    // Run-on steps of half the gap to the nearest plane (see raster.cpp).
+    // The pass's band, half way to the neighbouring planes, for its run-on (envelope.hpp).
     RunOnBand band{out.normal, 0.0};
     double gap = 4.0 * options.toolRadius;
     if (kk > range.first) band.lo = 0.5 * (offsetAt(kk - 1.0) + offset), gap = std::min(gap, offset - offsetAt(kk - 1.0));
     if (kk < range.last) band.hi = 0.5 * (offset + offsetAt(kk + 1.0)), gap = std::min(gap, offsetAt(kk + 1.0) - offset);
-    const double runOnStep = std::clamp(0.5 * gap, options.toolRadius / 64.0, options.toolRadius / 4.0);
+    const double step = runOnStep(gap, options.toolRadius);
     PlaneSection section = planeSection(surface, out.normal, offset, tolerance);
     out.stats.touchPoints += section.touchPoints.size();
     if (section.curves.empty()) continue;
@@ -197,17 +197,9 @@ ContourPaths contourPaths(const Surface& surface, const ContourOptions& options)
       // ends is otherwise left uncut (the simulated cut of paper-1 found scallops of 2.6 H
       // there with no run-on, 1.7 H with a fixed R / 4).
       if (distance && !curve.closed && !pass.moves.empty()) {
-        const Vec3 towardsStart = pass.start - pass.moves.front().end;
-        for (const Vec3& c : runOnPastEnd(*distance, pass.start, towardsStart, options.toolRadius,
-                                          band, runOnStep, kRunOnLength * options.toolRadius)) {
-          pass.moves.insert(pass.moves.begin(), {MoveKind::line, pass.start, {}, ArcPlane::xy, true});
-          pass.start = c;
-        }
-        const Vec3 last = pass.moves.back().end;
         const Vec3 penultimate = pass.moves.size() >= 2 ? pass.moves[pass.moves.size() - 2].end : pass.start;
-        for (const Vec3& c : runOnPastEnd(*distance, last, last - penultimate, options.toolRadius,
-                                          band, runOnStep, kRunOnLength * options.toolRadius))
-          pass.moves.push_back({MoveKind::line, c, {}, ArcPlane::xy, true});
+        runPassOn(*distance, pass, pass.start - pass.moves.front().end, passEnd(pass) - penultimate,
+                  options.toolRadius, band, step);
       }
       if (!pass.moves.empty()) out.path.passes.push_back(std::move(pass));
     }

@@ -613,6 +613,22 @@ std::vector<Vec3> runOnPastEnd(const SurfaceDistance& distance, Vec3 end, Vec3 d
   return out;
 }
 
+void runPassOn(const SurfaceDistance& distance, ToolPass& pass, Vec3 backward, Vec3 forward, double radius,
+               const RunOnBand& band, double step) {
+  const auto line = [](Vec3 end) { return ToolMove{MoveKind::line, end, {}, ArcPlane::xy, true}; };
+  for (const Vec3& c : runOnPastEnd(distance, passEnd(pass), forward, radius, band, step, kRunOnLength * radius))
+    pass.moves.push_back(line(c));
+  const std::vector<Vec3> before = runOnPastEnd(distance, pass.start, backward, radius, band, step, kRunOnLength * radius);
+  if (before.empty()) return;
+  // The pass now starts at the farthest vertex and comes back through the others.
+  std::vector<ToolMove> prefix;
+  prefix.reserve(before.size());
+  for (std::size_t i = before.size() - 1; i-- > 0;) prefix.push_back(line(before[i]));
+  prefix.push_back(line(pass.start));
+  pass.moves.insert(pass.moves.begin(), prefix.begin(), prefix.end());
+  pass.start = before.back();
+}
+
 std::vector<std::vector<Vec3>> dropLineRuns(const SurfaceDistance& distance, Vec3 origin,
                                             Vec3 direction, double from, double to, double radius,
                                             const RunOnBand& band, double step,

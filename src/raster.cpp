@@ -24,7 +24,6 @@ using detail::segmentClears;
 constexpr double kPi = std::numbers::pi;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-
 void requirePositive(const char* what, double value) {
   if (!(value > 0.0) || !std::isfinite(value))
     throw Error(fmt::format("{} must be a positive number, got {}", what, value));
@@ -592,8 +591,7 @@ RasterPaths rasterPaths(const Surface& surface, const RasterOptions& options) {
     double contactLength = 0.0;
     bool visible = false;
   };
-  const auto buildPlane = [&](double w, long long k, const RunOnBand& band, double runOnStep,
-                              bool dropLine) {
+  const auto buildPlane = [&](double w, long long k, const RunOnBand& band, double step, bool dropLine) {
     PlaneBuild b;
     PlaneSection section = planeSection(surface, frame.e, w, tolerance);
     out.stats.touchPoints += section.touchPoints.size();
@@ -615,22 +613,15 @@ RasterPaths rasterPaths(const Surface& surface, const RasterOptions& options) {
     for (RasterChain& chain : b.plane.chains) {
       chain.hull = scallopHull(chain.chain, radius);
       ToolPass pass = passFromHull(chain.hull, frame, w, arcTolerance);
-      if (options.dropEnvelope) {
-        // The pass runs on past both ends while its ball still finishes its own band of the
-        // surface (envelope.hpp, runOnPastEnd).
-        for (const Vec3& c : runOnPastEnd(distance, passEnd(pass), frame.d, radius, band, runOnStep, kRunOnLength * radius))
-          pass.moves.push_back(line(c));
-        for (const Vec3& c : runOnPastEnd(distance, pass.start, -frame.d, radius, band, runOnStep, kRunOnLength * radius)) {
-          pass.moves.insert(pass.moves.begin(), line(pass.start));
-          pass.start = c;
-        }
-      }
+      // The pass runs on past both ends while its ball still finishes its own band of the
+      // surface (envelope.hpp, runOnPastEnd).
+      if (options.dropEnvelope) runPassOn(distance, pass, -frame.d, frame.d, radius, band, step);
       b.passes.push_back(std::move(pass));
     }
     if (b.plane.chains.empty() && dropLine && options.dropEnvelope) {
       b.plane.dropLine = true;
       for (std::vector<Vec3>& run : dropLineRuns(distance, w * frame.e, frame.d, footLo - radius, footHi + radius,
-                                                 radius, band, runOnStep)) {
+                                                 radius, band, step)) {
         ToolPass pass;
         pass.start = run.front();
         for (std::size_t v = 1; v < run.size(); ++v) pass.moves.push_back(line(run[v]));
@@ -640,10 +631,6 @@ RasterPaths rasterPaths(const Surface& surface, const RasterOptions& options) {
     b.plane.section = std::move(section);
     return b;
   };
-  // Run-on steps of half the gap to the nearest plane: a chord of the envelope (radius of
-  // curvature >= R about an edge) then sags by at most gap^2 / (32 R), H / 4 sin^2(alpha) at
-  // the flat spacing.
-  const auto runOnStepFor = [&](double gap) { return std::clamp(0.5 * gap, radius / 64.0, radius / 4.0); };
 
   // With the drop envelope, planes beyond the outermost ones, at the outermost gap, while
   // their balls still finish points of the surface that no given plane's ball does: a raster
@@ -666,16 +653,16 @@ RasterPaths rasterPaths(const Surface& surface, const RasterOptions& options) {
         const double w = edge + static_cast<double>(side * j) * gap;
         RunOnBand band{frame.e, radius};
         (side < 0 ? band.hi : band.lo) = w - 0.5 * side * gap;
-        PlaneBuild b = buildPlane(w, edgeK + side * j, band, runOnStepFor(gap), true);
+        PlaneBuild b = buildPlane(w, edgeK + side * j, band, runOnStep(gap, radius), true);
         if (b.passes.empty()) break;
         (side < 0 ? below : above).push_back(std::move(b));
       }
     }
   }
-  std::vector<double> outerOffsets;  // every plane's w, in increasing order
-  for (auto b = below.rbegin(); b != below.rend(); ++b) outerOffsets.push_back(b->plane.offset);
-  for (double kk = range.first; kk <= range.last; kk += 1.0) outerOffsets.push_back(offsetAt(kk));
-  for (const PlaneBuild& b : above) outerOffsets.push_back(b.plane.offset);
+  std::vector<double> allOffsets;  // every plane's w, in increasing order
+  for (auto b = below.rbegin(); b != below.rend(); ++b) allOffsets.push_back(b->plane.offset);
+  for (double kk = range.first; kk <= range.last; kk += 1.0) allOffsets.push_back(offsetAt(kk));
+  for (const PlaneBuild& b : above) allOffsets.push_back(b.plane.offset);
 
   // A plane's passes into the path: zigzag, ways on and off, links from the previous plane.
   const auto appendPlane = [&](PlaneBuild&& b) {
@@ -745,12 +732,12 @@ RasterPaths rasterPaths(const Surface& surface, const RasterOptions& options) {
   for (auto b = below.rbegin(); b != below.rend(); ++b) appendPlane(std::move(*b));
   for (double kk = range.first; kk <= range.last; kk += 1.0) {
     const std::size_t at = below.size() + static_cast<std::size_t>(kk - range.first);
-    const double w = outerOffsets[at];
+    const double w = allOffsets[at];
     RunOnBand band{frame.e, radius};
     double gap = 4.0 * radius;
-    if (at > 0) band.lo = 0.5 * (outerOffsets[at - 1] + w), gap = std::min(gap, w - outerOffsets[at - 1]);
-    if (at + 1 < outerOffsets.size()) band.hi = 0.5 * (w + outerOffsets[at + 1]), gap = std::min(gap, outerOffsets[at + 1] - w);
-    appendPlane(buildPlane(w, static_cast<long long>(kk), band, runOnStepFor(gap), true));
+    if (at > 0) band.lo = 0.5 * (allOffsets[at - 1] + w), gap = std::min(gap, w - allOffsets[at - 1]);
+    if (at + 1 < allOffsets.size()) band.hi = 0.5 * (w + allOffsets[at + 1]), gap = std::min(gap, allOffsets[at + 1] - w);
+    appendPlane(buildPlane(w, static_cast<long long>(kk), band, runOnStep(gap, radius), true));
   }
   for (PlaneBuild& b : above) appendPlane(std::move(b));
   if (out.sections.empty())

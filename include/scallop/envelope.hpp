@@ -64,6 +64,7 @@
 //         maximum is not the global one). Moves come out about sqrt(8 eps rho) long on a
 //         curved stretch of lifted path (rho the path's radius of curvature).
 
+#include <algorithm>
 #include <cstddef>
 #include <limits>
 #include <memory>
@@ -202,6 +203,16 @@ inline constexpr double kRunOnLength = 4.0;
 std::vector<Vec3> runOnPastEnd(const SurfaceDistance& distance, Vec3 end, Vec3 direction,
                                double radius, const RunOnBand& band, double step, double length,
                                const EnvelopeOptions& options = {});
+
+/// The step the strategies run on with: half the gap to the nearest plane, within [R/64, R/4].
+/// A chord of the envelope (radius of curvature >= R about an edge) then sags by at most
+/// gap^2 / (32 R): H sin^2(alpha) / 4 at the flat spacing.
+inline double runOnStep(double gap, double radius) { return std::clamp(0.5 * gap, radius / 64.0, radius / 4.0); }
+
+/// Both ends of `pass` run on (runOnPastEnd, at most kRunOnLength R each): from its start
+/// along `backward`, from its end along `forward`, as line moves.
+void runPassOn(const SurfaceDistance& distance, ToolPass& pass, Vec3 backward, Vec3 forward, double radius,
+               const RunOnBand& band, double step);
 
 /// The drop envelope along the horizontal line origin + t h, t in [from, to] (h the unit
 /// horizontal direction), in runs. The vertices c_k at t = from + k step, k = 0, 1, ..., are
