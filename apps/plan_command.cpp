@@ -32,6 +32,7 @@
 #include "scallop/optimal_slicing.hpp"
 #include "scallop/orient_output.hpp"
 #include "scallop/paths_output.hpp"
+#include "scallop/rest_finishing.hpp"
 #include "scallop/verify_output.hpp"
 #include "scallop/surface.hpp"
 #include "surface_options.hpp"
@@ -56,8 +57,12 @@ struct PlanOptions {
   bool noDropEnvelope = false;
   bool oneWay = false;
   bool constantSpacing = false;
+  bool noRestFinishing = false;
   bool quiet = false;
 };
+
+// Rounds of rest finishing at most (each a simulation of the whole program more).
+constexpr int kRestRounds = 2;
 
 void runPlan(const PlanOptions& options) {
   if (!options.spacing.empty() && !options.scallopHeight.empty())
@@ -99,25 +104,13 @@ void runPlan(const PlanOptions& options) {
                                           orientation.certified,
                                           orientation.gaussMap.boundarySegments, orientation.seconds};
 
-  progress("writing G-code, report and figures");
   const GcodeDialect dialect = gcodeDialect(options.dialect);
   const std::string title = fmt::format("scallop plan {} {}", options.strategy, source);
-  const fs::path dir = options.out;
-  const std::string figureTitle = fmt::format(
-      "scallop plan: {} strategy on {}, R = {} {}, spacing {:.5g}, {} passes", options.strategy,
-      source, job.toolRadius, unitsName(surface.units), report.spacing, result.path.passes.size());
-  const GcodeOptions gcodeOptions = defaultGcodeOptions(surface, result.path, dialect, title);
-  report.motion = gcodeMotion(result.path, gcodeOptions, rapidRate);
-  report.feedRate = gcodeOptions.feedRate;
-  report.plungeFeedRate = gcodeOptions.plungeFeedRate;
-  report.rapidRate = rapidRate;
   const std::string programName = dialect == GcodeDialect::grbl ? "toolpath.gcode" : "toolpath.ngc";
-  const std::string program = gcodeProgram(result.path, gcodeOptions);
   // The program as written, read back and cut in simulation (scallop verify): the finishing
   // stock is the surface raised by half the links' clearance (what they assume roughing
   // left; at least 2 H, so scallops up to 2 H show), the scallop height the one asked (or the
   // flat-surface one of the spacing given).
-  progress("simulating the cut of the program (scallop verify)");
   SimulationOptions simulation;
   simulation.toolRadius = job.toolRadius;
   simulation.scallopHeight = job.scallopHeight
@@ -126,8 +119,49 @@ void runPlan(const PlanOptions& options) {
                                                               0.25 * report.spacing * report.spacing);
   simulation.stockAllowance = std::max(report.linking ? 0.5 * report.linking->clearance : (inch ? 0.01 : 0.25),
                                        2.0 * simulation.scallopHeight);
-  const SimulationReport simulated =
-      verifyProgram(surface, parseGcodeProgram(program, programName), simulation);
+  GcodeOptions gcodeOptions;
+  std::string program;
+  const auto writeAndSimulate = [&] {
+    gcodeOptions = defaultGcodeOptions(surface, result.path, dialect, title);
+    program = gcodeProgram(result.path, gcodeOptions);
+    progress("simulating the cut of the program (scallop verify)");
+    return verifyProgram(surface, parseGcodeProgram(program, programName), simulation);
+  };
+  progress("writing the G-code");
+  SimulationReport simulated = writeAndSimulate();
+  // Rest finishing (rest_finishing.hpp): where the simulated cut leaves more than H on points
+  // the ball can reach (corners whose ball stands outside the footprint, rims of pockets
+  // tighter than the ball), passes through the balls that touch them, linked in with the
+  // others; the program is simulated again. Only when H was asked and the spacing is ours.
+  report.restFinishing = job.scallopHeight && !job.constantSpacing && !options.noRestFinishing;
+  for (int round = 0; report.restFinishing && round < kRestRounds; ++round) {
+    // The first round also serves what the grid may straddle beside the pockets
+    // (restTargets); a second one only what the grid still reads above H.
+    if (round > 0 ? simulated.uncutPoints == 0 : restTargets(simulated, *job.scallopHeight).empty()) break;
+    RestOptions rest;
+    rest.toolRadius = job.toolRadius;
+    rest.scallopHeight = *job.scallopHeight;
+    rest.sagTolerance = *job.scallopHeight / 4.0;
+    if (report.envelope) rest.depthTolerance = report.envelope->depthTolerance;
+    progress(fmt::format("rest finishing: {} grid points left above H", simulated.uncutPoints));
+    RestRound summary{simulated.maxScallop, simulated.uncutArea, {}};
+    RestPasses passes = restPasses(surface, simulated, rest);
+    summary.rest = passes.report;
+    report.restRounds.push_back(summary);
+    if (passes.path.passes.empty()) break;
+    addPasses(surface, source, job, passes.path, result, progress);
+    simulated = writeAndSimulate();
+  }
+
+  progress("writing the report and figures");
+  const fs::path dir = options.out;
+  const std::string figureTitle = fmt::format(
+      "scallop plan: {} strategy on {}, R = {} {}, spacing {:.5g}, {} passes", options.strategy,
+      source, job.toolRadius, unitsName(surface.units), report.spacing, result.path.passes.size());
+  report.motion = gcodeMotion(result.path, gcodeOptions, rapidRate);
+  report.feedRate = gcodeOptions.feedRate;
+  report.plungeFeedRate = gcodeOptions.plungeFeedRate;
+  report.rapidRate = rapidRate;
   report.verification = VerificationSummary{simulated.design.spacing, simulated.heightErrorBound,
                                             *simulation.stockAllowance, simulated.maxGouge,
                                             simulated.maxGougeAt, simulated.gougeArea,
@@ -205,6 +239,10 @@ void addPlanCommand(CLI::App& app) {
   plan->add_flag("--constant-spacing", options->constantSpacing,
                   "with --scallop-height: the paper's constant plane spacing (flat-surface formula) "
                   "instead of adaptive offsets that keep the estimated cusp <= H on curved parts");
+  plan->add_flag("--no-rest-finishing", options->noRestFinishing,
+                 "no rest passes where the simulated cut leaves more than H on points the ball can "
+                 "reach (by default, with a scallop height and adaptive spacing, up to two rounds of "
+                 "them, each simulated again)");
   plan->add_option("--out", options->out, "output folder (default scallop-out)")->type_name("DIR");
   plan->add_flag("--quiet", options->quiet, "no progress lines");
   plan->callback([options] { runPlan(*options); });

@@ -217,6 +217,34 @@ void runRaster(const Surface& surface, const JobOptions& options, JobResult& res
   result.path = std::move(paths.path);
 }
 
+// Linking (linking.hpp): the finished path's passes ordered, and needless retracts to the
+// safe height replaced by proven direct feeds and local retracts; then the gouge check on the
+// path as it will be cut, links included.
+void linkAndCheck(const Surface& surface, const std::string& source, const JobOptions& options,
+                  JobResult& result, const Progress& progress) {
+  result.path = result.unlinkedPath;
+  if (options.link) {
+    say(progress, "ordering and linking the passes");
+    try {
+      // The links' margin and their plunges at feed must exceed the stock left above the
+      // surface: the cusps, up to the scallop height H (more at the boundary), so at least 4 H.
+      LinkOptions linking = options.linking;
+      const double standard = surface.units == Units::inch ? 0.02 : 0.5;
+      if (linking.clearance == 0.0 && options.scallopHeight)
+        linking.clearance = std::max(standard, 4.0 * *options.scallopHeight);
+      if (linking.plunge == 0.0 && options.scallopHeight)
+        linking.plunge = std::max(standard, 4.0 * *options.scallopHeight);
+      LinkedPath linked = linkToolPath(surface, result.path, linking);
+      result.path = std::move(linked.path);
+      result.report.linking = linked.stats;
+      result.report.linkMoves = std::move(linked.linkMoves);
+    } catch (const Error& error) {
+      throw Error(fmt::format("{}: {}", source, error.what()));
+    }
+  }
+  if (options.gougeCheck) checkGouge(surface, options, result, progress);
+}
+
 }  // namespace
 
 JobResult runToolpathJob(const Surface& surface, const std::string& source,
@@ -256,32 +284,19 @@ JobResult runToolpathJob(const Surface& surface, const std::string& source,
   } catch (const Error& error) {
     throw Error(fmt::format("{}: {}", source, error.what()));
   }
-  // Linking (linking.hpp): the finished path's passes ordered, and needless retracts to the
-  // safe height replaced by proven direct feeds and local retracts.
-  if (options.link) {
-    say(progress, "ordering and linking the passes");
-    try {
-      // The links' margin and their plunges at feed must exceed the stock left above the
-      // surface: the cusps, up to the scallop height H (more at the boundary), so at least 4 H.
-      LinkOptions linking = options.linking;
-      const double standard = surface.units == Units::inch ? 0.02 : 0.5;
-      if (linking.clearance == 0.0 && options.scallopHeight)
-        linking.clearance = std::max(standard, 4.0 * *options.scallopHeight);
-      if (linking.plunge == 0.0 && options.scallopHeight)
-        linking.plunge = std::max(standard, 4.0 * *options.scallopHeight);
-      LinkedPath linked = linkToolPath(surface, result.path, linking);
-      result.path = std::move(linked.path);
-      result.report.linking = linked.stats;
-      result.report.linkMoves = std::move(linked.linkMoves);
-    } catch (const Error& error) {
-      throw Error(fmt::format("{}: {}", source, error.what()));
-    }
-  }
-  // The gouge check on the path as it will be cut, links included.
-  if (options.gougeCheck) checkGouge(surface, options, result, progress);
+  result.unlinkedPath = result.path;
+  linkAndCheck(surface, source, options, result, progress);
   result.report.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
+}
+
+void addPasses(const Surface& surface, const std::string& source, const JobOptions& options,
+               const ToolPath& extra, JobResult& result, const Progress& progress) {
+  if (extra.units != result.unlinkedPath.units || extra.toolRadius != result.unlinkedPath.toolRadius)
+    throw Error("addPasses: the extra passes' units or tool radius differ from the job's");
+  result.unlinkedPath.passes.insert(result.unlinkedPath.passes.end(), extra.passes.begin(), extra.passes.end());
+  linkAndCheck(surface, source, options, result, progress);
 }
 
 GcodeOptions defaultGcodeOptions(const Surface& surface, const ToolPath& path,

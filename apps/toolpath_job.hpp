@@ -36,6 +36,9 @@ struct JobOptions {
 struct JobResult {
   PathsReport report;
   ToolPath path;
+  /// The strategy's passes before linking (the same as `path` without linking): what
+  /// addPasses links again with more passes.
+  ToolPath unlinkedPath;
   std::vector<std::vector<Vec3>> contactCurves;  ///< the sections, for the figures
   std::optional<OptimalSlicing> orientation;     ///< when N* was computed
 };
@@ -47,6 +50,11 @@ using Progress = std::function<void(const std::string&)>;
 JobResult runToolpathJob(const Surface& surface, const std::string& source,
                          const JobOptions& options, std::optional<OptimalSlicing> orientation,
                          const Progress& progress);
+
+/// `extra` passes (rest finishing: same units and radius) added to the job's unlinked
+/// passes, and the whole linked and gouge-checked again as runToolpathJob does.
+void addPasses(const Surface& surface, const std::string& source, const JobOptions& options,
+               const ToolPath& extra, JobResult& result, const Progress& progress);
 
 /// G-code options that suit the surface's units: feeds 40 / 15 in/min or 1000 / 400
 /// mm/min, 10,000 rpm, and a safe height 0.2 in (5 mm) above the highest of the surface's

@@ -198,6 +198,28 @@ std::string pathsToJson(const PathsReport& report, const ToolPath& path) {
     verification["seconds"] = v.seconds;
     document["verification"] = std::move(verification);
   }
+  if (report.restFinishing) {
+    Json rounds = Json::array();
+    for (const RestRound& round : report.restRounds) {
+      const RestReport& r = round.rest;
+      Json item;
+      item["max_scallop_before"] = round.maxScallopBefore;
+      item["uncut_area_before"] = round.uncutAreaBefore;
+      item["targets"] = r.targets;
+      item["witnesses"] = r.witnesses;
+      item["unreached"] = r.unreached;
+      item["over_budget"] = r.overBudget;
+      item["passes"] = r.passes;
+      item["length"] = r.length;
+      item["moves"] = r.envelope.movesOut;
+      item["proofs"] = r.envelope.proofs;
+      item["unproven_moves"] = r.envelope.unprovenMoves;
+      rounds.push_back(std::move(item));
+    }
+    document["rest_finishing"] = std::move(rounds);
+  } else {
+    document["rest_finishing"] = nullptr;
+  }
   if (report.gouge) {
     Json gouge;
     gouge["max_depth"] = report.gouge->maxDepth;

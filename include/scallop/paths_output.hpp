@@ -23,6 +23,7 @@
 #include "scallop/gcode.hpp"
 #include "scallop/gouge.hpp"
 #include "scallop/linking.hpp"
+#include "scallop/rest_finishing.hpp"
 #include "scallop/surface.hpp"
 #include "scallop/toolpath.hpp"
 #include "scallop/vector.hpp"
@@ -56,6 +57,14 @@ struct VerificationSummary {
   double maxUnreachableLeft = 0.0;
   std::size_t rapidsCutting = 0;
   double seconds = 0.0;
+};
+
+/// One round of `scallop plan`'s rest finishing: what the simulated cut left before it, and
+/// the rest passes added.
+struct RestRound {
+  double maxScallopBefore = 0.0;  ///< the simulated max scallop over reachable points, before
+  double uncutAreaBefore = 0.0;   ///< the area above H before
+  RestReport rest;
 };
 
 /// The scallop height on the curved surface (cusp.hpp), when the spacing came from H: the
@@ -100,6 +109,11 @@ struct PathsReport {
   std::vector<std::size_t> linkMoves;
   /// The simulated cut of the written program (`scallop plan`; none for `paths`).
   std::optional<VerificationSummary> verification;
+  /// `scallop plan`'s rest finishing (rest_finishing.hpp): one report per round of rest
+  /// passes added after a simulated cut, with the simulated figures before the round (the
+  /// `verification` above is of the final program). Empty: none was run or needed.
+  std::vector<RestRound> restRounds;
+  bool restFinishing = false;  ///< rest finishing was on (the rounds may still be none)
   /// The G-code program's motion and estimated cycle time (gcode.hpp's gcodeMotion), with
   /// the rates it assumed (units per minute).
   std::optional<GcodeMotion> motion;

@@ -1,0 +1,224 @@
+#include "scallop/rest_finishing.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <unordered_map>
+
+#include <fmt/format.h>
+
+#include "scallop/bezier.hpp"
+#include "scallop/error.hpp"
+#include "scallop/gouge.hpp"
+
+namespace scallop {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+void validate(const RestOptions& options) {
+  const auto positive = [](double value, const char* name) {
+    if (!(value > 0.0) || !std::isfinite(value))
+      throw Error(fmt::format("rest finishing: {} must be positive and finite, got {}", name, value));
+  };
+  positive(options.toolRadius, "the tool radius");
+  positive(options.scallopHeight, "the scallop height");
+  if (!(options.chainGap >= 0.0) || !std::isfinite(options.chainGap))
+    throw Error(fmt::format("rest finishing: the chain gap must be >= 0 and finite, got {}", options.chainGap));
+  if (!(options.depthTolerance >= 0.0) || !std::isfinite(options.depthTolerance))
+    throw Error(fmt::format("rest finishing: the depth tolerance must be >= 0 and finite, got {}",
+                            options.depthTolerance));
+  if (!(options.sagTolerance >= 0.0) || !std::isfinite(options.sagTolerance))
+    throw Error(fmt::format("rest finishing: the sag tolerance must be >= 0 and finite, got {}",
+                            options.sagTolerance));
+}
+
+// Witnesses in square buckets of side `gap` over xy: the nearest unvisited witness within
+// `gap` of a point lies in its own bucket or one of the eight around it.
+class WitnessBuckets {
+ public:
+  WitnessBuckets(const std::vector<Vec3>& points, double gap) : points_(points), gap_(gap) {
+    for (std::size_t k = 0; k < points.size(); ++k) buckets_[key(points[k])].push_back(k);
+  }
+
+  // The nearest unvisited witness to p within the gap (ties: the smaller index), removed;
+  // none: points.size().
+  std::size_t takeNearest(const Vec3& p) {
+    const auto [bx, by] = cell(p);
+    std::size_t best = points_.size();
+    double bestDistance = gap_;
+    for (std::int64_t dy = -1; dy <= 1; ++dy) {
+      for (std::int64_t dx = -1; dx <= 1; ++dx) {
+        const auto found = buckets_.find(pack(bx + dx, by + dy));
+        if (found == buckets_.end()) continue;
+        for (const std::size_t k : found->second) {
+          const double d = norm(points_[k] - p);
+          if (d < bestDistance || (d == bestDistance && k < best)) {
+            bestDistance = d;
+            best = k;
+          }
+        }
+      }
+    }
+    if (best < points_.size()) take(best);
+    return best;
+  }
+
+  void take(std::size_t k) {
+    std::vector<std::size_t>& bucket = buckets_[key(points_[k])];
+    bucket.erase(std::find(bucket.begin(), bucket.end(), k));
+  }
+
+ private:
+  std::pair<std::int64_t, std::int64_t> cell(const Vec3& p) const {
+    return {static_cast<std::int64_t>(std::floor(p.x / gap_)), static_cast<std::int64_t>(std::floor(p.y / gap_))};
+  }
+  static std::uint64_t pack(std::int64_t x, std::int64_t y) {
+    return (static_cast<std::uint64_t>(x) << 32) ^ (static_cast<std::uint64_t>(y) & 0xffffffffULL);
+  }
+  std::uint64_t key(const Vec3& p) const {
+    const auto [x, y] = cell(p);
+    return pack(x, y);
+  }
+
+  const std::vector<Vec3>& points_;
+  double gap_;
+  std::unordered_map<std::uint64_t, std::vector<std::size_t>> buckets_;
+};
+
+double scallopAt(const SimulationReport& simulated, std::size_t index) {
+  const double design = simulated.design.z[index];
+  if (design == -kInf) return 0.0;
+  if (!simulated.unreachable.empty() && simulated.unreachable[index]) return 0.0;
+  return std::max(0.0, simulated.stock.z[index] - design) * simulated.designNormalZ[index];
+}
+
+}  // namespace
+
+std::vector<std::size_t> restTargets(const SimulationReport& simulated, double scallopHeight,
+                                     double threshold, std::size_t neighbourhood) {
+  const HeightGrid& design = simulated.design;
+  if (design.z.empty() || design.z.size() != design.columns * design.rows ||
+      design.z.size() != simulated.stock.z.size() || simulated.designNormalZ.size() != design.z.size() ||
+      (!simulated.unreachable.empty() && simulated.unreachable.size() != design.z.size()))
+    throw Error("rest finishing: the simulation has no grids to read the scallops from");
+  if (!(scallopHeight > 0.0) || !std::isfinite(scallopHeight))
+    throw Error(fmt::format("rest finishing: the scallop height must be positive and finite, got {}", scallopHeight));
+  if (!(threshold >= 0.0 && threshold <= 1.0))
+    throw Error(fmt::format("rest finishing: the threshold must lie in (0, 1] (0: from the grid), got {}", threshold));
+  const double cut = scallopHeight * (threshold > 0.0 ? threshold
+                                                      : std::max(0.5, 1.0 - simulated.heightErrorBound / scallopHeight));
+  // The squares about the points above H or beyond reach, marked one by one.
+  std::vector<unsigned char> near(design.z.size(), 0);
+  const auto reach = static_cast<std::ptrdiff_t>(std::min<std::size_t>(neighbourhood, 1u << 20));
+  const auto columns = static_cast<std::ptrdiff_t>(design.columns);
+  const auto rows = static_cast<std::ptrdiff_t>(design.rows);
+  const auto mark = [&](std::ptrdiff_t i, std::ptrdiff_t j) {
+    for (std::ptrdiff_t jj = std::max<std::ptrdiff_t>(0, j - reach); jj <= std::min(rows - 1, j + reach); ++jj)
+      for (std::ptrdiff_t ii = std::max<std::ptrdiff_t>(0, i - reach); ii <= std::min(columns - 1, i + reach); ++ii)
+        near[static_cast<std::size_t>(jj * columns + ii)] = 1;
+  };
+  for (std::ptrdiff_t j = 0; j < rows; ++j) {
+    for (std::ptrdiff_t i = 0; i < columns; ++i) {
+      const auto index = static_cast<std::size_t>(j * columns + i);
+      const bool beyondReach = !simulated.unreachable.empty() && simulated.unreachable[index];
+      if (beyondReach || scallopAt(simulated, index) > scallopHeight) mark(i, j);
+    }
+  }
+  std::vector<std::size_t> targets;
+  for (std::size_t index = 0; index < design.z.size(); ++index)
+    if (near[index] && scallopAt(simulated, index) > cut) targets.push_back(index);
+  return targets;
+}
+
+RestPasses restPasses(const Surface& surface, const SimulationReport& simulated, const RestOptions& options) {
+  validate(options);
+  const std::vector<std::size_t> targets =
+      restTargets(simulated, options.scallopHeight, options.threshold, options.neighbourhood);
+  const HeightGrid& design = simulated.design;
+  const double radius = options.toolRadius;
+  const double height = options.scallopHeight;
+
+  RestPasses out;
+  out.path.units = surface.units;
+  out.path.toolRadius = radius;
+  RestReport& report = out.report;
+  for (const std::size_t index : targets)
+    report.maxScallopBefore = std::max(report.maxScallopBefore, scallopAt(simulated, index));
+  report.targets = targets.size();
+  if (targets.empty()) return out;
+  if (targets.size() > options.maxTargets) {
+    report.overBudget = true;
+    return out;
+  }
+
+  // Their witnesses: the ball touching q, dropped onto the envelope.
+  const SurfaceDistance distance(surface);
+  EnvelopeOptions lifting;
+  lifting.depthTolerance = options.depthTolerance;
+  lifting.sagTolerance = options.sagTolerance;
+  lifting.stretchThreshold = height;
+  lifting.threads = options.threads;
+  DropCutter cutter(distance, radius, lifting);
+  std::vector<Vec3> witnesses;
+  for (const std::size_t index : targets) {
+    const Vec2 p = design.point(index % design.columns, index / design.columns);
+    const Vec3 q{p.x, p.y, design.z[index]};
+    const ClosestPoint foot = distance.closest(q);
+    Vec3 n = unitNormal(surface.patches[foot.patch], foot.u, foot.v);
+    if (n.z < 0.0) n = -n;
+    const Vec3 c = q + radius * n;
+    const double z = cutter.height(c.x, c.y);
+    if (!std::isfinite(z)) {
+      ++report.unreached;  // nothing within R of the vertical: the ball cannot touch q from there
+      continue;
+    }
+    const double lift = std::max(0.0, z - c.z);
+    const double gap = std::sqrt(radius * radius + 2.0 * radius * lift * n.z + lift * lift) - radius;
+    if (gap > height) {
+      ++report.unreached;
+      continue;
+    }
+    witnesses.push_back({c.x, c.y, std::max(z, c.z)});
+  }
+  report.witnesses = witnesses.size();
+  if (witnesses.empty()) return out;
+
+  // Chains, nearest next.
+  const double gap = options.chainGap > 0.0 ? options.chainGap : std::min(8.0 * design.spacing, radius);
+  WitnessBuckets buckets(witnesses, gap);
+  std::vector<bool> visited(witnesses.size(), false);
+  ToolPath chains;
+  chains.units = surface.units;
+  chains.toolRadius = radius;
+  for (std::size_t first = 0; first < witnesses.size(); ++first) {
+    if (visited[first]) continue;
+    visited[first] = true;
+    buckets.take(first);
+    ToolPass pass;
+    pass.start = witnesses[first];
+    pass.retractBefore = true;
+    Vec3 at = pass.start;
+    for (std::size_t next = buckets.takeNearest(at); next < witnesses.size(); next = buckets.takeNearest(at)) {
+      visited[next] = true;
+      at = witnesses[next];
+      pass.moves.push_back(ToolMove{MoveKind::line, at, {}, ArcPlane::xy, true});
+    }
+    if (pass.moves.empty()) pass.moves.push_back(ToolMove{MoveKind::line, at, {}, ArcPlane::xy, true});
+    chains.passes.push_back(std::move(pass));
+  }
+  report.passes = chains.passes.size();
+
+  out.path = liftToDropEnvelope(distance, chains, lifting, report.envelope);
+  for (const ToolPass& pass : out.path.passes) {
+    Vec3 at = pass.start;
+    for (const ToolMove& move : pass.moves) {
+      report.length += norm(move.end - at);
+      at = move.end;
+    }
+  }
+  return out;
+}
+
+}  // namespace scallop
