@@ -64,6 +64,23 @@ struct PlanOptions {
 // Rounds of rest finishing at most (each a simulation of the whole program more).
 constexpr int kRestRounds = 2;
 
+// "; rest finishing: ..." when rest passes were added (what the strategies left, what it took).
+std::string restSummary(const PathsReport& report, Units units) {
+  std::size_t passes = 0, targets = 0;
+  double length = 0.0;
+  for (const RestRound& round : report.restRounds) {
+    passes += round.rest.passes;
+    targets += round.rest.targets;
+    length += round.rest.length;
+  }
+  if (report.restRounds.empty()) return {};
+  const RestRound& first = report.restRounds.front();
+  if (first.rest.overBudget)
+    return fmt::format("; rest finishing skipped: {} points to finish exceed its budget", first.rest.targets);
+  return fmt::format("; rest finishing: {} passes, {:.3f} {}, for {} grid points (scallop max {:.6f} before)", passes,
+                     length, unitsName(units), targets, first.maxScallopBefore);
+}
+
 void runPlan(const PlanOptions& options) {
   if (!options.spacing.empty() && !options.scallopHeight.empty())
     throw CLI::ValidationError("plan", "give at most one of --spacing and --scallop-height");
@@ -203,7 +220,8 @@ void runPlan(const PlanOptions& options) {
                              simulated.unreachablePoints > 0
                                  ? fmt::format(", {:.4f} {}^2 beyond the ball's reach", simulated.unreachableArea,
                                                unitsName(surface.units))
-                                 : std::string()),
+                                 : std::string()) +
+                 restSummary(report, surface.units),
              report.seconds + orientation.seconds,
              options.out);
 }
