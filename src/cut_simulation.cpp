@@ -615,16 +615,8 @@ SimulationReport simulateCut(const Surface& surface, const std::vector<SweptMove
         const std::size_t index = uncut[k];
         const Vec2 p = design.point(index % design.columns, index / design.columns);
         const Vec3 q{p.x, p.y, design.z[index]};
-        const ClosestPoint foot = distance.closest(q);
-        Vec3 n = unitNormal(surface.patches[foot.patch], foot.u, foot.v);
-        if (n.z < 0.0) n = -n;
-        const Vec3 c = q + radius * n;
-        const double z = cutter.height(c.x, c.y);
-        if (!std::isfinite(z)) continue;
-        const double lift = std::max(0.0, z - c.z);
-        // |c + lift z - q| - R: how near to q the ball comes from where it would touch it.
-        const double gap = std::sqrt(radius * radius + 2.0 * radius * lift * n.z + lift * lift) - radius;
-        if (gap > options.scallopHeight) report.unreachable[index] = 1;
+        const ReachWitness witness = reachWitness(distance, cutter, q, radius);
+        if (witness.centre && witness.gap > options.scallopHeight) report.unreachable[index] = 1;
       }
     };
     const std::size_t threads =
@@ -676,6 +668,21 @@ SimulationReport simulateCut(const Surface& surface, const std::vector<SweptMove
   report.unreachableArea = static_cast<double>(report.unreachablePoints) * cellArea;
   report.seconds = secondsSince(start);
   return report;
+}
+
+ReachWitness reachWitness(const SurfaceDistance& distance, DropCutter& cutter, Vec3 q, double radius) {
+  const ClosestPoint foot = distance.closest(q);
+  Vec3 n = unitNormal(distance.surface().patches[foot.patch], foot.u, foot.v);
+  if (n.z < 0.0) n = -n;
+  const Vec3 c = q + radius * n;
+  const double z = cutter.height(c.x, c.y);
+  ReachWitness out;
+  if (!std::isfinite(z)) return out;
+  const double lift = std::max(0.0, z - c.z);
+  out.centre = Vec3{c.x, c.y, c.z + lift};
+  // |c + lift z - q| - R: how near to q the ball comes from where it would touch it.
+  out.gap = std::sqrt(radius * radius + 2.0 * radius * lift * n.z + lift * lift) - radius;
+  return out;
 }
 
 SimulationReport verifyProgram(const Surface& surface, const GcodeProgram& program,

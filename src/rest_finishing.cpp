@@ -165,22 +165,13 @@ RestPasses restPasses(const Surface& surface, const SimulationReport& simulated,
   for (const std::size_t index : targets) {
     const Vec2 p = design.point(index % design.columns, index / design.columns);
     const Vec3 q{p.x, p.y, design.z[index]};
-    const ClosestPoint foot = distance.closest(q);
-    Vec3 n = unitNormal(surface.patches[foot.patch], foot.u, foot.v);
-    if (n.z < 0.0) n = -n;
-    const Vec3 c = q + radius * n;
-    const double z = cutter.height(c.x, c.y);
-    if (!std::isfinite(z)) {
-      ++report.unreached;  // nothing within R of the vertical: the ball cannot touch q from there
-      continue;
-    }
-    const double lift = std::max(0.0, z - c.z);
-    const double gap = std::sqrt(radius * radius + 2.0 * radius * lift * n.z + lift * lift) - radius;
-    if (gap > height) {
+    const ReachWitness witness = reachWitness(distance, cutter, q, radius);
+    // No centre: nothing within R of the vertical, the ball cannot touch q from there.
+    if (!witness.centre || witness.gap > height) {
       ++report.unreached;
       continue;
     }
-    witnesses.push_back({c.x, c.y, std::max(z, c.z)});
+    witnesses.push_back(*witness.centre);
   }
   report.witnesses = witnesses.size();
   if (witnesses.empty()) return out;

@@ -99,7 +99,9 @@
 #include <string>
 #include <vector>
 
+#include "scallop/envelope.hpp"
 #include "scallop/gcode_reader.hpp"
+#include "scallop/gouge.hpp"
 #include "scallop/surface.hpp"
 #include "scallop/toolpath.hpp"
 #include "scallop/vector.hpp"
@@ -235,6 +237,17 @@ double sweepEvaluations(const std::vector<SweptMove>& moves, double toolRadius, 
 /// `lowered`, if given, receives per move the largest amount it lowered the stock by.
 std::size_t sweepMoves(const std::vector<SweptMove>& moves, double toolRadius, HeightGrid& stock,
                        std::vector<double>* lowered = nullptr);
+
+/// The ball that touches a surface point q from above, as the contract's Reach defines it:
+/// the centre c = q + R n (n the upward unit normal at q's foot point) raised onto the drop
+/// envelope over c (`cutter`, whose radius is R), and how far that ball stays from q,
+/// gap = |centre - q| - R = sqrt(R^2 + 2 R L n_z + L^2) - R for a lift L >= 0. No centre
+/// where nothing of the surface lies within R of that vertical.
+struct ReachWitness {
+  std::optional<Vec3> centre;
+  double gap = std::numeric_limits<double>::infinity();
+};
+ReachWitness reachWitness(const SurfaceDistance& distance, DropCutter& cutter, Vec3 q, double radius);
 
 /// The whole simulation: grid, design, sweep, comparison.
 SimulationReport simulateCut(const Surface& surface, const std::vector<SweptMove>& moves,
