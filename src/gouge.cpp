@@ -54,16 +54,17 @@ constexpr int kMaxTreeDepth = 6;
 bool isFinite(Vec3 a) { return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z); }
 double maxAbs(Vec3 a) { return std::max({std::abs(a.x), std::abs(a.y), std::abs(a.z)}); }
 
+// The same with the count fixed at compile time and the six extremes in scalars (kept in
+// registers across the unrolled loop; min and max are exact, so the same box).
 template <std::size_t Count>
 Box boxOfFixed(const Vec3* net) {
-  Box box{net[0], net[0]};
+  double loX = net[0].x, loY = net[0].y, loZ = net[0].z;
+  double hiX = loX, hiY = loY, hiZ = loZ;
   for (std::size_t i = 1; i < Count; ++i) {
-    box.lo = {std::min(box.lo.x, net[i].x), std::min(box.lo.y, net[i].y),
-              std::min(box.lo.z, net[i].z)};
-    box.hi = {std::max(box.hi.x, net[i].x), std::max(box.hi.y, net[i].y),
-              std::max(box.hi.z, net[i].z)};
+    loX = std::min(loX, net[i].x), loY = std::min(loY, net[i].y), loZ = std::min(loZ, net[i].z);
+    hiX = std::max(hiX, net[i].x), hiY = std::max(hiY, net[i].y), hiZ = std::max(hiZ, net[i].z);
   }
-  return box;
+  return {{loX, loY, loZ}, {hiX, hiY, hiZ}};
 }
 
 Box boxOf(const Vec3* net, std::size_t count) {
