@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -53,7 +54,21 @@ constexpr int kMaxTreeDepth = 6;
 bool isFinite(Vec3 a) { return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z); }
 double maxAbs(Vec3 a) { return std::max({std::abs(a.x), std::abs(a.y), std::abs(a.z)}); }
 
+// The same with the count fixed at compile time and the six extremes in scalars (kept in
+// registers across the unrolled loop; min and max are exact, so the same box).
+template <std::size_t Count>
+Box boxOfFixed(const Vec3* net) {
+  double loX = net[0].x, loY = net[0].y, loZ = net[0].z;
+  double hiX = loX, hiY = loY, hiZ = loZ;
+  for (std::size_t i = 1; i < Count; ++i) {
+    loX = std::min(loX, net[i].x), loY = std::min(loY, net[i].y), loZ = std::min(loZ, net[i].z);
+    hiX = std::max(hiX, net[i].x), hiY = std::max(hiY, net[i].y), hiZ = std::max(hiZ, net[i].z);
+  }
+  return {{loX, loY, loZ}, {hiX, hiY, hiZ}};
+}
+
 Box boxOf(const Vec3* net, std::size_t count) {
+  if (count == 16) return boxOfFixed<16>(net);  // bicubic: unrolled (the search's hot loop)
   Box box{net[0], net[0]};
   for (std::size_t i = 1; i < count; ++i) {
     box.lo = {std::min(box.lo.x, net[i].x), std::min(box.lo.y, net[i].y),
@@ -62,6 +77,12 @@ Box boxOf(const Vec3* net, std::size_t count) {
               std::max(box.hi.z, net[i].z)};
   }
   return box;
+}
+
+// 2^-depth, exactly (depth <= kMaxCellDepth): the side of a cell in u and v. Built from the
+// exponent bits, as std::ldexp would give it, without its library call in the hot loops.
+double cellSide(int depth) {
+  return std::bit_cast<double>(static_cast<std::uint64_t>(1023 - depth) << 52);
 }
 
 // How far 0 lies outside [lo, hi].
@@ -96,7 +117,31 @@ double separatingPlaneDistance(const Vec3* net, int m, int n, Vec3 p) {
 // subdivideV at t = 1/2 (bit for bit: halving by 0.5 * (a + b) is exact scaling of one
 // rounded sum either way), without its Bernstein2 temporaries, so that building the trees
 // and the search loop do not allocate per cell.
+// The same with the degree fixed at compile time (unrolled; the same operations in the same
+// order, so the same bits).
+template <int N>
+void halveCurveFixed(const Vec3* b, std::ptrdiff_t s, Vec3* left, Vec3* right) {
+  std::array<Vec3, N + 1> t;
+  for (int i = 0; i <= N; ++i) t[static_cast<std::size_t>(i)] = b[i * s];
+  left[0] = t[0];
+  right[N * s] = t[static_cast<std::size_t>(N)];
+  for (int r = 1; r <= N; ++r) {
+    for (int i = 0; i <= N - r; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      t[k] = 0.5 * (t[k] + t[k + 1]);
+    }
+    left[r * s] = t[0];
+    right[(N - r) * s] = t[static_cast<std::size_t>(N - r)];
+  }
+}
+
 void halveCurve(const Vec3* b, int n, std::ptrdiff_t s, Vec3* left, Vec3* right) {
+  switch (n) {  // the common degrees unrolled
+    case 1: return halveCurveFixed<1>(b, s, left, right);
+    case 2: return halveCurveFixed<2>(b, s, left, right);
+    case 3: return halveCurveFixed<3>(b, s, left, right);
+    default: break;
+  }
   std::array<Vec3, kMaxPatchDegree + 1> t;
   for (int i = 0; i <= n; ++i) t[static_cast<std::size_t>(i)] = b[i * s];
   left[0] = t[0];
@@ -113,7 +158,23 @@ void halveCurve(const Vec3* b, int n, std::ptrdiff_t s, Vec3* left, Vec3* right)
 
 // The four quarters of a net, in the order (u half, v half) = (0,0), (0,1), (1,0), (1,1),
 // written at out, out + size, .. (size = (m + 1)(n + 1); out must not overlap net).
+template <int M, int N>
+void halveNetFixed(const Vec3* net, Vec3* out) {
+  constexpr int stride = N + 1;
+  constexpr std::ptrdiff_t size = (M + 1) * stride;
+  Vec3* const lowU = out;
+  Vec3* const highU = out + 2 * size;
+  for (int k = 0; k <= N; ++k) halveCurveFixed<M>(net + k, stride, lowU + k, highU + k);
+  for (Vec3* half : {lowU, highU}) {
+    for (int j = 0; j <= M; ++j) {
+      Vec3* row = half + j * stride;
+      halveCurveFixed<N>(row, 1, row, row + size);
+    }
+  }
+}
+
 void halveNet(const Vec3* net, int m, int n, Vec3* out) {
+  if (m == 3 && n == 3) return halveNetFixed<3, 3>(net, out);  // bicubic, the usual patch
   const int stride = n + 1;
   const std::ptrdiff_t size = (m + 1) * stride;
   Vec3* const lowU = out;
@@ -145,6 +206,20 @@ CurveJet curveJet(Vec3* b, int n, double t) {
   return {s * e0 + t * e1, nn * (e1 - e0), (nn * (nn - 1.0)) * (b[2] - 2.0 * b[1] + b[0])};
 }
 
+// The same with the degree fixed at compile time (the same operations, so the same bits).
+template <int N>
+CurveJet curveJetFixed(Vec3* b, double t) {
+  static_assert(N >= 2);
+  const double s = 1.0 - t;
+  for (int count = N + 1; count > 3; --count) {
+    for (int i = 0; i + 1 < count; ++i) b[i] = s * b[i] + t * b[i + 1];
+  }
+  const Vec3 e0 = s * b[0] + t * b[1];
+  const Vec3 e1 = s * b[1] + t * b[2];
+  const double nn = N;
+  return {s * e0 + t * e1, nn * (e1 - e0), (nn * (nn - 1.0)) * (b[2] - 2.0 * b[1] + b[0])};
+}
+
 // r and its partial derivatives to second order at (u, v).
 struct Jet {
   Vec3 r, ru, rv, ruu, ruv, rvv;
@@ -152,6 +227,21 @@ struct Jet {
 Jet jetAt(const BezierPatch& patch, double u, double v) {
   const int m = patch.degreeU;
   const int n = patch.degreeV;
+  if (m == 3 && n == 3) {  // bicubic, unrolled
+    std::array<Vec3, 4> row, value, dv, dvv;
+    for (int j = 0; j <= 3; ++j) {
+      std::copy_n(patch.control.begin() + j * 4, 4, row.begin());
+      const CurveJet c = curveJetFixed<3>(row.data(), v);
+      const auto k = static_cast<std::size_t>(j);
+      value[k] = c.d0;
+      dv[k] = c.d1;
+      dvv[k] = c.d2;
+    }
+    const CurveJet a = curveJetFixed<3>(value.data(), u);
+    const CurveJet b = curveJetFixed<3>(dv.data(), u);
+    const CurveJet c = curveJetFixed<3>(dvv.data(), u);
+    return {a.d0, a.d1, b.d0, a.d2, b.d1, c.d0};
+  }
   std::array<Vec3, kMaxPatchDegree + 1> row;
   std::array<Vec3, kMaxPatchDegree + 1> value;
   std::array<Vec3, kMaxPatchDegree + 1> dv;
@@ -390,7 +480,7 @@ template <class Consider>
 Box cornersAndBox(const PatchTree& tree, const Cell& cell, const Vec3* net, Consider&& consider) {
   const int m = tree.degreeU;
   const int n = tree.degreeV;
-  const double h = std::ldexp(1.0, -cell.depth);
+  const double h = cellSide(cell.depth);
   consider(net[0], cell.patch, cell.u0, cell.v0);
   consider(net[n], cell.patch, cell.u0, cell.v0 + h);
   consider(net[m * (n + 1)], cell.patch, cell.u0 + h, cell.v0);
@@ -407,7 +497,7 @@ struct Scratch {
 // while it goes that deep, else halved into the query's arena.
 template <typename Offer>
 void offerQuarters(const Cell& cell, const PatchTree& tree, std::vector<Vec3>& arena, const Offer& offer) {
-  const double half = std::ldexp(0.5, -cell.depth);
+  const double half = cellSide(cell.depth + 1);
   if (cell.inTree && cell.depth + 1 < tree.levels) {
     const auto side = std::size_t{1} << cell.depth;
     const std::size_t iu = cell.net / side;
@@ -559,7 +649,7 @@ ClosestPoint search(const Surface& surface, const std::vector<PatchTree>& trees,
       break;
     }
     const BezierPatch& patch = surface.patches[cell.patch];
-    const double h = std::ldexp(1.0, -cell.depth);
+    const double h = cellSide(cell.depth);
     const double uc = cell.u0 + 0.5 * h;
     const double vc = cell.v0 + 0.5 * h;
     const Jet jet = jetAt(patch, uc, vc);
