@@ -9,9 +9,11 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <exception>
 #include <limits>
 #include <numbers>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <fmt/format.h>
@@ -1031,35 +1033,90 @@ GougeReport gougeCheck(const SurfaceDistance& distance, const ToolPath& path, do
     if (s.steps > 0) maxGap = std::max(maxGap, s.length / static_cast<double>(s.steps));
   }
 
+  // Blocks of consecutive segments of about kGougeSamplesPerBlock samples (see the contract).
+  std::vector<std::size_t> blockStarts{0};
+  std::size_t inBlock = 0;
+  for (std::size_t k = 0; k < segments.size(); ++k) {
+    if (inBlock >= kGougeSamplesPerBlock) {
+      blockStarts.push_back(k);
+      inBlock = 0;
+    }
+    inBlock += segments[k].steps + 1;
+  }
+  blockStarts.push_back(segments.size());
+  const double countBelow = radius - options.depthThreshold;
+  struct Block {
+    double least = kInfinity;        // the least distance found
+    double leastProven = kInfinity;  // the least lower bound of any sample's distance
+    std::size_t samples = 0, deeper = 0, startsBelow = 0;
+    GougeLocation deepest;
+  };
+  std::vector<Block> blocks(blockStarts.size() - 1);
+  std::vector<std::exception_ptr> errors(blocks.size());
+  const auto sampleBlock = [&](std::size_t b) {
+    Block& block = blocks[b];
+    for (std::size_t k = blockStarts[b]; k < blockStarts[b + 1]; ++k) {
+      const Segment& s = segments[k];
+      for (std::size_t i = s.sampleStart ? 0 : 1; i <= s.steps; ++i) {
+        const Vec3 center = positionOn(s, i);
+        // A sample farther than both the least distance so far and R - threshold changes
+        // nothing in the block's report: let the search drop it early. A retracted pass's
+        // first centre is found in full, for the test of its side.
+        const double cutoff = s.sampleStart ? kInfinity : std::max(block.least, countBelow);
+        const ClosestPoint contact = distance.closest(center, cutoff);
+        ++block.samples;
+        block.leastProven = std::min(block.leastProven, contact.lowerBound);
+        if (contact.distance < countBelow) ++block.deeper;
+        if (contact.distance < block.least) {
+          block.least = contact.distance;
+          block.deepest = {s.pass, s.move, s.onLink, center, contact};
+        }
+        if (s.sampleStart && contact.distance > distance.tolerance()) {
+          // Material side: opposite the upward normal at the closest point (see the contract);
+          // unitNormal's limit on an apex row, where r_u x r_v itself vanishes.
+          Vec3 up = unitNormal(distance.surface().patches[contact.patch], contact.u, contact.v);
+          if (up.z < 0.0) up = -up;
+          if (up.z > 0.0 && dot(center - contact.point, up) < 0.0) ++block.startsBelow;
+        }
+      }
+    }
+  };
+  const std::size_t threads = std::clamp<std::size_t>(
+      options.threads > 0 ? options.threads : std::thread::hardware_concurrency(), 1, blocks.size());
+  {
+    // Blocks dealt round-robin: thread t takes t, t + threads, ... (the work per block is
+    // alike); each writes only its own blocks.
+    const auto run = [&](std::size_t first) {
+      for (std::size_t b = first; b < blocks.size(); b += threads) {
+        try {
+          sampleBlock(b);
+        } catch (...) {
+          errors[b] = std::current_exception();
+        }
+      }
+    };
+    std::vector<std::jthread> pool;
+    for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(run, t);
+    run(0);
+  }
+  for (const std::exception_ptr& error : errors) {
+    if (error) std::rethrow_exception(error);  // the first block's error, whatever the timing
+  }
+
   GougeReport report;
   report.depthThreshold = options.depthThreshold;
   report.maxSampleGap = maxGap;
   report.tolerance = distance.tolerance();
-  double least = kInfinity;        // the least distance found
-  double leastProven = kInfinity;  // the least lower bound of any sample's distance
-  const double countBelow = radius - options.depthThreshold;
-  for (const Segment& s : segments) {
-    for (std::size_t i = s.sampleStart ? 0 : 1; i <= s.steps; ++i) {
-      const Vec3 center = positionOn(s, i);
-      // A sample farther than both the least distance so far and R - threshold changes
-      // nothing in the report: let the search drop it early. A retracted pass's first centre
-      // is found in full, for the test of its side.
-      const double cutoff = s.sampleStart ? kInfinity : std::max(least, countBelow);
-      const ClosestPoint contact = distance.closest(center, cutoff);
-      ++report.samples;
-      leastProven = std::min(leastProven, contact.lowerBound);
-      if (contact.distance < countBelow) ++report.samplesDeeperThanThreshold;
-      if (contact.distance < least) {
-        least = contact.distance;
-        report.deepest = {s.pass, s.move, s.onLink, center, contact};
-      }
-      if (s.sampleStart && contact.distance > report.tolerance) {
-        // Material side: opposite the upward normal at the closest point (see the contract);
-        // unitNormal's limit on an apex row, where r_u x r_v itself vanishes.
-        Vec3 up = unitNormal(distance.surface().patches[contact.patch], contact.u, contact.v);
-        if (up.z < 0.0) up = -up;
-        if (up.z > 0.0 && dot(center - contact.point, up) < 0.0) ++report.passStartsBelowSurface;
-      }
+  double least = kInfinity;
+  double leastProven = kInfinity;
+  for (const Block& block : blocks) {
+    report.samples += block.samples;
+    report.samplesDeeperThanThreshold += block.deeper;
+    report.passStartsBelowSurface += block.startsBelow;
+    leastProven = std::min(leastProven, block.leastProven);
+    if (block.least < least) {
+      least = block.least;
+      report.deepest = block.deepest;
     }
   }
   if (report.samples > 0) {

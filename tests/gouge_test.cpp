@@ -545,6 +545,64 @@ TEST(GougeCheck, LiftedPathOverPaperSurfaceDoesNotGouge) {
   EXPECT_GE(report.samples, 7u * 175u);
 }
 
+// Many blocks of samples (kGougeSamplesPerBlock), passes dipping into paper-1 here and there:
+// the report is the same for any number of threads, and its deepest sample is the deepest of
+// a sequential walk over the same samples with the full distance (no early exit).
+TEST(GougeCheck, SameReportForAnyNumberOfThreads) {
+  const Surface surface = exampleSurface("paper-1");
+  std::vector<ToolPass> passes;
+  for (int i = 0; i <= 24; ++i) {
+    const double y = 0.125 * i;
+    ToolPass pass{{-0.25, y, 2.0}, {}, true};
+    for (int k = 1; k <= 40; ++k) {
+      const double x = -0.25 + 3.5 * k / 40.0;
+      // Mostly well above, every seventh vertex down into the surface.
+      const double z = (i * 40 + k) % 7 == 0 ? 0.6 + 0.01 * (i % 5) : 2.0;
+      pass.moves.push_back(line({x, y, z}));
+    }
+    passes.push_back(pass);
+  }
+  const ToolPath path = pathOf(passes);
+  const double spacing = 0.004;
+  GougeOptions one;
+  one.threads = 1;
+  const GougeReport reference = gougeCheck(surface, path, spacing, one);
+  ASSERT_GT(reference.samples, 4u * kGougeSamplesPerBlock);
+  ASSERT_GT(reference.maxDepth, 0.0);
+  for (const std::size_t threads : {2u, 3u, 5u}) {
+    GougeOptions options;
+    options.threads = threads;
+    const GougeReport report = gougeCheck(surface, path, spacing, options);
+    EXPECT_EQ(report.samples, reference.samples) << threads;
+    EXPECT_EQ(report.signedMaxDepth, reference.signedMaxDepth) << threads;
+    EXPECT_EQ(report.depthBound, reference.depthBound) << threads;
+    EXPECT_EQ(report.samplesDeeperThanThreshold, reference.samplesDeeperThanThreshold) << threads;
+    EXPECT_EQ(report.passStartsBelowSurface, reference.passStartsBelowSurface) << threads;
+    EXPECT_EQ(report.deepest.pass, reference.deepest.pass) << threads;
+    EXPECT_EQ(report.deepest.move, reference.deepest.move) << threads;
+    EXPECT_EQ(report.deepest.center, reference.deepest.center) << threads;
+  }
+  // The deepest sample against a walk that queries every sample in full.
+  const SurfaceDistance distance(surface);
+  double least = std::numeric_limits<double>::infinity();
+  std::size_t deeper = 0;
+  for (const ToolPass& pass : path.passes) {
+    Vec3 at = pass.start;
+    for (const ToolMove& move : pass.moves) {
+      const double length = norm(move.end - at);
+      const auto steps = static_cast<std::size_t>(std::ceil(length / spacing));
+      for (std::size_t i = 0; i <= steps; ++i) {
+        const double d = distance.closest(at + (static_cast<double>(i) / static_cast<double>(steps)) * (move.end - at)).distance;
+        least = std::min(least, d);
+        if (d < kRadius) ++deeper;
+      }
+      at = move.end;
+    }
+  }
+  EXPECT_NEAR(reference.signedMaxDepth, kRadius - least, 2.0 * distance.tolerance());
+  EXPECT_GT(deeper, 0u);
+}
+
 TEST(GougeCheck, FlagsPassesStartingInsideTheMaterial) {
   const double r = kRadius;
   const ToolPath path = pathOf({{{0.5, 1.0, -1.0}, {line({3.5, 1.0, -1.0})}, true}});

@@ -104,6 +104,11 @@
 //         maxSamples samples (a tiny spacing on a long path); the message names the value
 //         and, for the path, the pass and move.
 // Complexity: O(path length / s + number of moves) samples, each one distance query.
+// Threads: the samples are taken in fixed blocks of consecutive moves (about
+//         kGougeSamplesPerBlock samples each, cut where the path says, never where a thread
+//         count says), each block with its own early-exit state, on every core
+//         (GougeOptions::threads); the blocks' reports are combined in path order (the first
+//         deepest sample wins a tie). The report is the same for any number of threads.
 
 #include <cstddef>
 #include <limits>
@@ -230,7 +235,12 @@ struct GougeOptions {
   /// Refuse paths that would take more samples than this (>= 1).
   std::size_t maxSamples = 10'000'000;
   DistanceOptions distance;  ///< for the surface distance queries
+  /// Threads sampling blocks at once; 0: every core. The report is the same for any number.
+  std::size_t threads = 0;
 };
+
+/// Samples per block of the gouge check's threads (see the contract).
+inline constexpr std::size_t kGougeSamplesPerBlock = 4096;
 
 /// Where the deepest sample lies.
 struct GougeLocation {
