@@ -664,9 +664,10 @@ std::optional<CadFormat> cadFormatOf(const std::string& path) {
   char buffer[256];
   const std::size_t count = std::fread(buffer, 1, sizeof buffer, file);
   std::fclose(file);
-  const std::string_view head = content(std::string_view(buffer, count));
-  if (head.starts_with("ISO-10303-21;")) return CadFormat::step;
-  const std::string_view first = head.substr(0, head.find('\n'));
+  const std::string_view raw(buffer, count);
+  if (content(raw).starts_with("ISO-10303-21;")) return CadFormat::step;
+  // IGES's start line is blank up to its text: no blanks skipped.
+  const std::string_view first = raw.substr(0, raw.find('\n'));
   if (first.size() >= 73 && first[72] == 'S' && (first.size() == 80 || (first.size() == 81 && first.back() == '\r')))
     return CadFormat::iges;
   return std::nullopt;
