@@ -262,7 +262,7 @@ Handle(Geom_Surface) exactBasis(Handle(Geom_Surface) surface) {
       Handle(Geom_Surface) equivalent = offset->Surface();
       if (equivalent.IsNull())
         throw FaceRefused{CadFaceIssue::unsupportedSurface,
-                          fmt::format("an offset ({}) of {}, which has no exact B-spline form: offset "
+                          fmt::format("is an offset ({}) of {}, which has no exact B-spline form: offset "
                                       "surfaces are not supported",
                                       offset->Offset(), surfaceKind(offset->BasisSurface()))};
       surface = equivalent;
@@ -275,7 +275,7 @@ Handle(Geom_Surface) exactBasis(Handle(Geom_Surface) surface) {
     const auto swept = Handle(Geom_SweptSurface)::DownCast(surface);
     if (!exactCurve(swept->BasisCurve()))
       throw FaceRefused{CadFaceIssue::unsupportedSurface,
-                        fmt::format("{} of a {}, which has no exact B-spline form", surfaceKind(surface),
+                        fmt::format("is {} of a {}, which has no exact B-spline form", surfaceKind(surface),
                                     swept->BasisCurve()->DynamicType()->Name())};
     return surface;
   }
@@ -284,7 +284,7 @@ Handle(Geom_Surface) exactBasis(Handle(Geom_Surface) surface) {
                      surface->IsKind(STANDARD_TYPE(Geom_ToroidalSurface)) || surface->IsKind(STANDARD_TYPE(Geom_BSplineSurface)) ||
                      surface->IsKind(STANDARD_TYPE(Geom_BezierSurface));
   if (!known)
-    throw FaceRefused{CadFaceIssue::unsupportedSurface, fmt::format("unsupported surface kind {}", surfaceKind(surface))};
+    throw FaceRefused{CadFaceIssue::unsupportedSurface, fmt::format("has an unsupported surface kind, {}", surfaceKind(surface))};
   return surface;
 }
 
@@ -322,8 +322,8 @@ Rectangle parameterRectangle(const TopoDS_Face& face, const Handle(Geom_Surface)
   for (TopoDS_Iterator it(face); it.More(); it.Next()) wires += it.Value().ShapeType() == TopAbs_WIRE ? 1 : 0;
   if (wires != 1)
     throw FaceRefused{CadFaceIssue::trimmed,
-                      wires == 0 ? std::string("face is trimmed (no boundary wire): trimmed faces are not supported yet")
-                                 : fmt::format("face is trimmed ({} wires: holes): trimmed faces are not supported yet", wires)};
+                      wires == 0 ? std::string("is trimmed (no boundary wire): trimmed faces are not supported yet")
+                                 : fmt::format("is trimmed ({} wires: holes): trimmed faces are not supported yet", wires)};
   struct EdgeOnSurface {
     gp_Pnt2d first, last;
     std::vector<gp_Pnt2d> deciding;
@@ -336,13 +336,13 @@ Rectangle parameterRectangle(const TopoDS_Face& face, const Handle(Geom_Surface)
     double first = 0.0, last = 0.0;
     const Handle(Geom2d_Curve) pcurve = BRep_Tool::CurveOnSurface(edge, face, first, last);
     if (pcurve.IsNull())
-      throw FaceRefused{CadFaceIssue::trimmed, fmt::format("face has an edge ({}) without a curve in its parameter "
+      throw FaceRefused{CadFaceIssue::trimmed, fmt::format("has an edge ({}) without a curve in its parameter "
                                                            "plane: trimmed faces are not supported yet", edges.size())};
     edges.push_back({pcurve->Value(first), pcurve->Value(last), decidingPoints(pcurve, first, last),
                      BRep_Tool::Tolerance(edge), pcurve->DynamicType()->Name()});
   }
   if (edges.empty())
-    throw FaceRefused{CadFaceIssue::trimmed, "face is trimmed (a wire without edges): trimmed faces are not supported yet"};
+    throw FaceRefused{CadFaceIssue::trimmed, "is trimmed (a wire without edges): trimmed faces are not supported yet"};
   Rectangle r{edges[0].first.X(), edges[0].first.X(), edges[0].first.Y(), edges[0].first.Y(), 0.0, 0.0};
   double tolerance3d = 0.0;
   for (const EdgeOnSurface& e : edges) {
@@ -373,9 +373,9 @@ Rectangle parameterRectangle(const TopoDS_Face& face, const Handle(Geom_Surface)
     else if (all([&](const gp_Pnt2d& p) { return std::abs(p.Y() - r.v1) <= r.tolV; })) side = 3;
     if (side < 0)
       throw FaceRefused{CadFaceIssue::trimmed,
-                        fmt::format("face is trimmed (edge {} of {}, a {} from ({:.6g}, {:.6g}) to ({:.6g}, {:.6g}), is not on "
-                                    "the boundary of the parameter rectangle [{:.6g}, {:.6g}] x [{:.6g}, {:.6g}]): "
-                                    "trimmed faces are not supported yet",
+                        fmt::format("is trimmed (edge {} of {}, a {} from ({:.6g}, {:.6g}) to ({:.6g}, {:.6g}), is not an "
+                                    "iso-line on a side of the rectangle [{:.6g}, {:.6g}] x [{:.6g}, {:.6g}] that the "
+                                    "edges' ends span): trimmed faces are not supported yet",
                                     i, edges.size(), e.kind, e.first.X(), e.first.Y(), e.last.X(), e.last.Y(), r.u0,
                                     r.u1, r.v0, r.v1)};
     covered[static_cast<std::size_t>(side)] +=
@@ -386,7 +386,7 @@ Rectangle parameterRectangle(const TopoDS_Face& face, const Handle(Geom_Surface)
     const double tol = side < 2 ? r.tolV : r.tolU;
     if (covered[side] < length - 2.0 * tol * static_cast<double>(edges.size()))
       throw FaceRefused{CadFaceIssue::trimmed,
-                        fmt::format("face is trimmed (its edges cover {:.6g} of the side {} of length {:.6g} of the parameter "
+                        fmt::format("is trimmed (its edges cover {:.6g} of the side {} of length {:.6g} of the parameter "
                                     "rectangle): trimmed faces are not supported yet",
                                     covered[side], sideNames[side], length)};
   }
@@ -409,7 +409,7 @@ Rectangle parameterRectangle(const TopoDS_Face& face, const Handle(Geom_Surface)
     if (r.v1 - r.v0 > surface->VPeriod() - r.tolV) r.v1 = r.v0 + surface->VPeriod();
   }
   if (!(r.u1 - r.u0 > r.tolU) || !(r.v1 - r.v0 > r.tolV))
-    throw FaceRefused{CadFaceIssue::trimmed, fmt::format("face has an empty parameter rectangle [{:.6g}, {:.6g}] x [{:.6g}, {:.6g}]",
+    throw FaceRefused{CadFaceIssue::trimmed, fmt::format("has an empty parameter rectangle [{:.6g}, {:.6g}] x [{:.6g}, {:.6g}]",
                                                          r.u0, r.u1, r.v0, r.v1)};
   return r;
 }
@@ -425,19 +425,42 @@ Handle(Geom_BSplineSurface) bsplineOn(const Handle(Geom_Surface)& basis, const R
     // Unbounded or periodic kinds: trimmed to the face first, so the conversion is bounded.
     spline = GeomConvert::SurfaceToBSplineSurface(new Geom_RectangularTrimmedSurface(basis, r.u0, r.u1, r.v0, r.v1));
   }
-  if (spline->IsUPeriodic()) spline->SetUNotPeriodic();
-  if (spline->IsVPeriodic()) spline->SetVNotPeriodic();
-  if (!basis->IsKind(STANDARD_TYPE(Geom_BSplineSurface)) && !basis->IsKind(STANDARD_TYPE(Geom_BezierSurface)))
+  const bool converted =
+      !basis->IsKind(STANDARD_TYPE(Geom_BSplineSurface)) && !basis->IsKind(STANDARD_TYPE(Geom_BezierSurface));
+  if (converted) {
+    if (spline->IsUPeriodic()) spline->SetUNotPeriodic();
+    if (spline->IsVPeriodic()) spline->SetVNotPeriodic();
     return spline;  // converted on the rectangle already
+  }
+  // A periodic direction: a face around the whole period is the whole closed surface (wherever
+  // its seam), one period's copy; a face on part of it may cross the seam, so it is cut out of
+  // the periodic surface itself (Segment works across the seam).
+  double u0 = r.u0, u1 = r.u1, v0 = r.v0, v1 = r.v1;
+  const bool fullU = spline->IsUPeriodic() && u1 - u0 >= spline->UPeriod() - r.tolU;
+  const bool fullV = spline->IsVPeriodic() && v1 - v0 >= spline->VPeriod() - r.tolV;
+  if (fullU) spline->SetUNotPeriodic();
+  if (fullV) spline->SetVNotPeriodic();
   double bu0 = 0.0, bu1 = 0.0, bv0 = 0.0, bv1 = 0.0;
   spline->Bounds(bu0, bu1, bv0, bv1);
-  // Ends within tolerance of the surface's are the surface's (no sliver patch); ends inside
-  // are snapped to knots by Segment's tolerances.
-  const double u0 = r.u0 - bu0 <= r.tolU ? bu0 : r.u0;
-  const double u1 = bu1 - r.u1 <= r.tolU ? bu1 : r.u1;
-  const double v0 = r.v0 - bv0 <= r.tolV ? bv0 : r.v0;
-  const double v1 = bv1 - r.v1 <= r.tolV ? bv1 : r.v1;
-  if (u0 != bu0 || u1 != bu1 || v0 != bv0 || v1 != bv1) spline->Segment(u0, u1, v0, v1, r.tolU, r.tolV);
+  // Ends within tolerance of (or, by a pcurve's rounding, beyond) the surface's are the
+  // surface's: no sliver patch. Ends inside are snapped to knots by Segment's tolerances.
+  const auto snap = [](double& lo, double& hi, double first, double last, double tol, bool periodic) {
+    if (periodic) {
+      if (std::abs(lo - first) <= tol) lo = first;
+      if (std::abs(hi - last) <= tol) hi = last;
+      return;
+    }
+    if (lo - first <= tol) lo = first;
+    if (last - hi <= tol) hi = last;
+  };
+  snap(u0, u1, bu0, bu1, r.tolU, spline->IsUPeriodic());
+  snap(v0, v1, bv0, bv1, r.tolV, spline->IsVPeriodic());
+  if (fullU) u0 = bu0, u1 = bu1;
+  if (fullV) v0 = bv0, v1 = bv1;
+  if (spline->IsUPeriodic() || spline->IsVPeriodic() || u0 != bu0 || u1 != bu1 || v0 != bv0 || v1 != bv1)
+    spline->Segment(u0, u1, v0, v1, r.tolU, r.tolV);
+  if (spline->IsUPeriodic()) spline->SetUNotPeriodic();
+  if (spline->IsVPeriodic()) spline->SetVNotPeriodic();
   return spline;
 }
 
@@ -487,7 +510,7 @@ void checkConversion(const Handle(Geom_Surface)& original, const Handle(Geom_BSp
     }
   if (!(worst <= kConversionTolerance * size))
     throw FaceRefused{CadFaceIssue::unsupportedSurface,
-                      fmt::format("converting {} to a B-spline is not exact (off by {:.3g}, {:.3g} of its size): not supported",
+                      fmt::format("is {}, whose conversion to a B-spline is not exact (off by {:.3g}, {:.3g} of its size): not supported",
                                   surfaceKind(original), worst, size > 0.0 ? worst / size : worst)};
 }
 
@@ -499,7 +522,7 @@ struct Stage {
 
 std::vector<BezierPatch> facePatches(const TopoDS_Face& face, Units units, Stage& stage) {
   const Handle(Geom_Surface) located = BRep_Tool::Surface(face);  // the face's location applied
-  if (located.IsNull()) throw FaceRefused{CadFaceIssue::unsupportedSurface, "face has no surface"};
+  if (located.IsNull()) throw FaceRefused{CadFaceIssue::unsupportedSurface, "has no surface"};
   const Handle(Geom_Surface) basis = exactBasis(located);
   stage.what = "checking its boundary";
   const Rectangle rectangle = parameterRectangle(face, basis);
@@ -523,7 +546,7 @@ std::vector<BezierPatch> facePatches(const TopoDS_Face& face, Units units, Stage
     }
   if (!polynomial)
     throw FaceRefused{CadFaceIssue::rational,
-                      fmt::format("rational surface (weights {:.6g} to {:.6g}, {}): rational faces are not supported yet",
+                      fmt::format("is rational (weights {:.6g} to {:.6g}, {}): rational faces are not supported yet",
                                   range.min, range.max, surfaceKind(basis))};
   stage.what = "checking the conversion";
   checkConversion(basis, spline, rectangle);
@@ -549,8 +572,9 @@ std::vector<BezierPatch> facePatches(const TopoDS_Face& face, Units units, Stage
     validateSurface(Surface{units, patches});
   } catch (const Error& error) {
     std::string message = error.what();
-    if (message.starts_with("patches[")) message = "Bezier piece " + message.substr(8);  // "patches[i]..." of this face
-    throw FaceRefused{CadFaceIssue::invalidPatch, fmt::format("{} ({}, {} pieces)", message, surfaceKind(basis), patches.size())};
+    if (message.starts_with("patches[")) message = "piece " + message.substr(8);  // "patches[i]..." of this face
+    throw FaceRefused{CadFaceIssue::invalidPatch, fmt::format("has an invalid Bezier {} ({}, {} pieces)", message,
+                                                              surfaceKind(basis), patches.size())};
   }
   return patches;
 }
@@ -618,9 +642,11 @@ Transferred readIges(const std::string& path) {
   IGESData_GlobalSection global = model->GlobalSection();
   const Handle(TCollection_HAsciiString) unitName = global.UnitName();
   result.fileUnit = unitName.IsNull() ? fmt::format("flag {}", global.UnitFlag()) : std::string(unitName->ToCString());
-  // Unit flag 1 is the inch (IGES 5.3, global parameter 14). OCCT scales the file's lengths
-  // to the "cascade unit" (millimetres per unit) recorded in the model at parse time.
-  const bool inch = global.UnitFlag() == 1;
+  // Unit flag 1 is the inch (IGES 5.3, global parameter 14); flag 3 names the unit in
+  // parameter 15. OCCT scales the file's lengths to the "cascade unit" (millimetres per unit)
+  // recorded in the model at parse time.
+  const std::string named = unitName.IsNull() ? std::string() : lowerCase(unitName->ToCString());
+  const bool inch = global.UnitFlag() == 1 || (global.UnitFlag() == 3 && (named == "in" || named == "inch"));
   result.units = inch ? Units::inch : Units::millimetre;
   global.SetCascadeUnit(inch ? 25.4 : 1.0);
   model->SetGlobalSection(global);
@@ -720,7 +746,7 @@ CadImport importCad(const std::string& path, CadFormat format, const CadImportOp
         patches = facePatches(face, transferred.units, stage);
       } catch (const Standard_Failure& failure) {
         throw FaceRefused{CadFaceIssue::unsupportedSurface,
-                          fmt::format("OpenCASCADE failed {}{} ({})", stage.what,
+                          fmt::format("could not be converted: OpenCASCADE failed {}{} ({})", stage.what,
                                       stage.rectangle ? fmt::format(" on [{:.17g}, {:.17g}] x [{:.17g}, {:.17g}]",
                                                                     stage.rectangle->u0, stage.rectangle->u1,
                                                                     stage.rectangle->v0, stage.rectangle->v1)
@@ -733,8 +759,8 @@ CadImport importCad(const std::string& path, CadFormat format, const CadImportOp
       }
     } catch (const FaceRefused& refused) {
       const std::string name = faceName(index, entityLabel(transferred.session, face));
-      if (!options.skipUnsupportedFaces) throw Error(fmt::format("{}: {}: {}", path, name, refused.reason));
-      result.skipped.push_back({index, refused.issue, fmt::format("{}: {}", name, refused.reason)});
+      if (!options.skipUnsupportedFaces) throw Error(fmt::format("{}: {} {}", path, name, refused.reason));
+      result.skipped.push_back({index, refused.issue, fmt::format("{} {}", name, refused.reason)});
     }
   }
   result.faces = index;

@@ -285,6 +285,41 @@ TEST_F(CadImportTest, AFaceOnASubRectangleIsTheSurfaceRestrictedExactly) {
     EXPECT_LE(distanceToSpline(imported.surface.patches[i], spline, us[i], us[i + 1], 0.1, 0.4), 1e-12) << i;
 }
 
+TEST_F(CadImportTest, AFaceAcrossThePeriodicSeamOfABSplineIsCutOutOfTheRing) {
+  // A periodic bicubic ring in u (period [0, 1), knots at quarters) by a cubic Bezier in v.
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> noise(-0.1, 0.1);
+  TColgp_Array2OfPnt poles(1, 4, 1, 4);
+  for (int i = 1; i <= 4; ++i)
+    for (int j = 1; j <= 4; ++j) {
+      const double angle = 2.0 * M_PI * (i - 1) / 4.0;
+      poles(i, j) = gp_Pnt((3.0 + noise(rng)) * std::cos(angle), (3.0 + noise(rng)) * std::sin(angle), j + noise(rng));
+    }
+  TColStd_Array1OfReal uKnots(1, 5), vKnots(1, 2);
+  TColStd_Array1OfInteger uMults(1, 5), vMults(1, 2);
+  for (int i = 1; i <= 5; ++i) uKnots(i) = (i - 1) / 4.0, uMults(i) = 1;
+  vKnots(1) = 0.0, vKnots(2) = 1.0, vMults(1) = 4, vMults(2) = 4;
+  const Handle(Geom_BSplineSurface) ring =
+      new Geom_BSplineSurface(poles, uKnots, vKnots, uMults, vMults, 3, 3, true, false);
+  ASSERT_TRUE(ring->IsUPeriodic());
+  // u in [-0.25, 0.25]: across the seam at 0, two knot intervals.
+  BRepBuilderAPI_MakeFace make(ring, -0.25, 0.25, 0.0, 1.0, Precision::Confusion());
+  ASSERT_TRUE(make.IsDone());
+  const fs::path path = dir_ / "seam.step";
+  writeStep(make.Face(), path, "MM");
+  const CadImport imported = scallop::importCad(path.string());
+  ASSERT_EQ(imported.surface.patches.size(), 2u);
+  EXPECT_LE(distanceToSpline(imported.surface.patches[0], ring, -0.25, 0.0, 0.0, 1.0), 1e-12);
+  EXPECT_LE(distanceToSpline(imported.surface.patches[1], ring, 0.0, 0.25, 0.0, 1.0), 1e-12);
+  // The whole ring: four patches, one per knot interval.
+  const fs::path whole = dir_ / "ring.step";
+  writeStep(faceOf(ring), whole, "MM");
+  const CadImport all = scallop::importCad(whole.string());
+  ASSERT_EQ(all.surface.patches.size(), 4u);
+  for (std::size_t i = 0; i < 4; ++i)
+    EXPECT_LE(distanceToSpline(all.surface.patches[i], ring, static_cast<double>(i) / 4.0, static_cast<double>(i + 1) / 4.0, 0.0, 1.0), 1e-12) << i;
+}
+
 TEST_F(CadImportTest, TheFaceLocationIsApplied) {
   const Surface original = exampleFile("paper-1");
   gp_Trsf rotation, translation;

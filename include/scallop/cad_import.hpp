@@ -10,8 +10,9 @@
 //         the order of OCCT's TopExp_Explorer over the transferred shape (every occurrence of a
 //         face in an assembly is a face of its own, placed), numbered from 0: "face N".
 // Units:  the file's length unit: inches when the file says inches (STEP: every length unit
-//         of its shape representations is INCH; IGES: unit flag 1), Units::inch and
-//         coordinates in inches; otherwise OCCT converts to millimetres, Units::millimetre.
+//         of its shape representations is INCH; IGES: unit flag 1, or 3 with the name IN or
+//         INCH), Units::inch and coordinates in inches; otherwise OCCT converts to
+//         millimetres, Units::millimetre.
 // Faces:  per face, its surface with the face's location applied (BRep_Tool::Surface):
 //         - kinds: B-spline and Bezier surfaces as they are; planes, cylinders, cones,
 //           spheres, tori, and extrusions and revolutions of lines, conics, B-spline and
@@ -48,8 +49,8 @@
 // Errors: scallop::Error, one line naming the file and, for a face, "face N" with its entity
 //         in the file where OCCT tells it (STEP "#123", IGES "D45"), the reason and the
 //         values, e.g.
-//           "part.step: face 3 (#812): rational surface (weights 0.7071 to 1, a cylinder):
-//            rational faces are not supported yet".
+//           "part.step: face 3 (#812) is rational (weights 0.707107 to 1, a cylinder): rational
+//            faces are not supported yet".
 //         File errors: cannot open; empty; not STEP (no "ISO-10303-21;" at the start) or not
 //         IGES (no start line 'S' in column 73); truncated (a STEP file without its
 //         "END-ISO-10303-21;", an IGES file whose terminate line is missing or whose section
