@@ -241,13 +241,16 @@ void addOrientCommand(CLI::App& app) {
       "When the Gauss map leaves no direction free, 'no slicing direction exists' is said only "
       "with a proof that the normals cover the sphere; otherwise the best direction found, "
       "certified.\n"
+      "A STEP (.step, .stp) or IGES (.iges, .igs) file is read through OpenCASCADE: every face "
+      "becomes Bezier patches exactly, in the file's units (inches or millimetres); rational and "
+      "trimmed faces are refused (--skip-faces leaves them out).\n"
       "A .stl file (binary or ASCII) is a triangle mesh: N* is then the centre of the largest "
       "spherical cap free of its +-facet normals (their convex hull's facet nearest the origin), "
       "alpha* the least angle to them; JSON only.\n"
       "Example: scallop orient --example teapot-body --json out.json --svg-dir figs");
 
   addSurfaceSourceOptions(*orient, options->surface,
-                          "surface file (JSON or .bpt, Bezier patches; .stl: a triangle mesh); - reads standard input",
+                          "surface file (JSON or .bpt, Bezier patches; .step/.stp or .iges/.igs: CAD faces; .stl: a triangle mesh); - reads standard input",
                           "use a built-in example surface instead");
   orient
       ->add_option("--tolerance", options->tolerance,

@@ -124,7 +124,7 @@ void addPathsCommand(CLI::App& app) {
       "the planes and the surface: Delta = 2 sqrt(2 R H - H^2) sin(alpha).\n"
       "Example: scallop paths --example paper-1 --tool-radius 0.25 --scallop-height 0.001 "
       "--gcode out.ngc --svg out.svg");
-  addSurfaceSourceOptions(*paths, options->surface, "surface file (JSON or .bpt); - reads standard input",
+  addSurfaceSourceOptions(*paths, options->surface, "surface file (JSON or .bpt; .step/.stp or .iges/.igs); - reads standard input",
                           "use a built-in example surface");
   paths->add_option("--tool-radius", options->toolRadius, "ball radius R, in the surface's units")
       ->required()

@@ -86,7 +86,7 @@ void runPlan(const PlanOptions& options) {
     throw CLI::ValidationError("plan", "give at most one of --spacing and --scallop-height");
   SurfaceSource from = options.surface;
   if (from.input.empty() && from.example.empty()) from.example = "paper-1";  // the main job
-  const Surface surface = loadSurface(from);
+  const Surface surface = loadSurface(from, !options.quiet);
   const std::string source = sourceName(from);
   const bool inch = surface.units == Units::inch;
   auto progress = [&](const std::string& line) {
@@ -238,7 +238,7 @@ void addPlanCommand(CLI::App& app) {
       "report.json (with the simulated cut of the program), verify.svg (its heat map), "
       "paths.svg, paths-plan.svg, gauss-map.svg and stereographic.svg into "
       "scallop-out/ (or --out DIR), all or nothing.");
-  addSurfaceSourceOptions(*plan, options->surface, "surface file (JSON or .bpt); - reads standard input",
+  addSurfaceSourceOptions(*plan, options->surface, "surface file (JSON or .bpt; .step/.stp or .iges/.igs); - reads standard input",
                           "a built-in example (default paper-1)");
   addStrategyOption(*plan, options->strategy);
   plan->add_option("--tool-radius", options->toolRadius, "ball radius R (default 0.25 in or 6 mm)")

@@ -1,11 +1,15 @@
 #include "surface_options.hpp"
 
 #include <cstddef>
+#include <cstdio>
+#include <map>
+#include <optional>
 #include <string_view>
 #include <vector>
 
 #include <fmt/format.h>
 
+#include "scallop/cad_import.hpp"
 #include "scallop/error.hpp"
 #include "scallop/surface_io.hpp"
 
@@ -38,7 +42,36 @@ std::string sourceBaseName(const SurfaceSource& source) {
   return source.input == "-" ? std::string("<stdin>") : source.input;
 }
 
+// A STEP or IGES file through scallop::cad, and the line that says what came of it: the
+// units especially, which the file chose and every length on the command line is in.
+Surface importCadSurface(const SurfaceSource& source, CadFormat format, bool announce) {
+  CadImportOptions options;
+  options.skipUnsupportedFaces = source.skipFaces;
+  CadImport imported = importCad(source.input, format, options);
+  if (announce) {
+    std::string skipped;
+    if (!imported.skipped.empty()) {
+      std::map<std::string_view, std::size_t> issues;
+      for (const SkippedFace& face : imported.skipped) ++issues[cadFaceIssueName(face.issue)];
+      std::string counts;
+      for (const auto& [issue, count] : issues) counts += fmt::format("{}{} {}", counts.empty() ? "" : ", ", count, issue);
+      skipped = fmt::format("; {} faces skipped ({}), the first: {}", imported.skipped.size(), counts,
+                            imported.skipped.front().reason);
+    }
+    fmt::print(stderr, "scallop: {}: {}, {} faces -> {} Bezier patches, units {} (the file's: {}){}; {:.2f} s\n",
+               source.input, cadFormatName(imported.format), imported.faces, imported.surface.patches.size(),
+               unitsName(imported.surface.units), imported.fileUnit, skipped, imported.seconds);
+  }
+  return std::move(imported.surface);
+}
+
 }  // namespace
+
+void addSkipFacesOption(CLI::App& command, SurfaceSource& source) {
+  command.add_flag("--skip-faces", source.skipFaces,
+                   "STEP/IGES: leave out the faces that cannot be imported exactly (rational, trimmed, "
+                   "other kinds) instead of failing; they are counted on stderr");
+}
 
 void addSurfaceSourceOptions(CLI::App& command, SurfaceSource& source, const std::string& fileHelp,
                              const std::string& exampleHelp) {
@@ -52,23 +85,31 @@ void addSurfaceSourceOptions(CLI::App& command, SurfaceSource& source, const std
                   "keep only these patches of the surface: 0-based indices and ranges, e.g. 4 or "
                   "4-7,12")
       ->type_name("LIST");
+  addSkipFacesOption(command, source);
 }
 
 void requireOneSurfaceSource(const SurfaceSource& source, const std::string& command) {
   if (source.input.empty() == source.example.empty()) {
     throw CLI::ValidationError(command,
-                               "give the surface either as SURFACE (.json or .bpt) or as --example NAME");
+                               "give the surface either as SURFACE (.json, .bpt, .step or .iges) or as --example NAME");
   }
 }
 
-Surface loadSurface(const SurfaceSource& source) {
+Surface loadSurface(const SurfaceSource& source, bool announce) {
+  const std::optional<CadFormat> cad =
+      source.example.empty() ? cadFormatOf(source.input) : std::optional<CadFormat>();
+  if (source.skipFaces && !cad)
+    throw Error(fmt::format("{}: --skip-faces is for STEP and IGES files", sourceBaseName(source)));
   if (source.patches.empty()) {
+    if (cad) return importCadSurface(source, *cad, announce);
     return source.example.empty() ? readSurface(source.input) : exampleSurface(source.example);
   }
   const std::string name = sourceBaseName(source);
-  // Examples are built, not read: they are not validated (as without --patches).
-  const Surface whole = source.example.empty() ? readSurface(source.input, SurfaceCheck::formOnly)
-                                               : exampleSurface(source.example);
+  // Examples are built, not read: they are not validated (as without --patches). A CAD
+  // import validates every patch it returns.
+  const Surface whole = cad ? importCadSurface(source, *cad, announce)
+                        : source.example.empty() ? readSurface(source.input, SurfaceCheck::formOnly)
+                                                 : exampleSurface(source.example);
   std::vector<std::size_t> indices;
   try {
     indices = parsePatchSelection(source.patches, whole.patches.size());
@@ -76,7 +117,7 @@ Surface loadSurface(const SurfaceSource& source) {
     throw Error(fmt::format("{}: --patches: {}", name, error.what()));
   }
   Surface selected = selectPatches(whole, indices);
-  if (source.example.empty()) validateSelection(selected, indices, name);
+  if (source.example.empty() && !cad) validateSelection(selected, indices, name);
   return selected;
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 // Command-line pieces that `orient`, `paths` and `plan` share: where the surface comes from
-// (a JSON or .bpt file, standard input or a built-in example, and which of its patches) and,
+// (a JSON, .bpt, STEP or IGES file, standard input or a built-in example, and which of its
+// patches) and,
 // for the tool-path commands, the strategy and the G-code dialect.
 
 #include <string>
@@ -13,15 +14,18 @@
 namespace scallop::cli {
 
 /// SURFACE (a path, "-" for standard input) or --example NAME; at most one is set. `patches`,
-/// when not empty, keeps only those patches of the surface (--patches "4-7,12").
+/// when not empty, keeps only those patches of the surface (--patches "4-7,12"). `skipFaces`:
+/// a STEP or IGES file's faces that cannot be imported exactly are left out (--skip-faces)
+/// instead of failing.
 struct SurfaceSource {
   std::string input;
   std::string example;
   std::string patches;
+  bool skipFaces = false;
 };
 
 /// Adds the SURFACE positional and --example NAME (checked against the built-in names,
-/// mutually exclusive) and --patches LIST to `command`.
+/// mutually exclusive), --patches LIST and --skip-faces to `command`.
 void addSurfaceSourceOptions(CLI::App& command, SurfaceSource& source, const std::string& fileHelp,
                              const std::string& exampleHelp);
 
@@ -29,11 +33,17 @@ void addSurfaceSourceOptions(CLI::App& command, SurfaceSource& source, const std
 /// is given.
 void requireOneSurfaceSource(const SurfaceSource& source, const std::string& command);
 
-/// The surface: the example if named, else the file (JSON or .bpt; scallop::Error naming the
-/// file on bad input), reduced to the selected patches if any. With a selection, a file is
-/// validated after the selection, so the patches not kept need not be regular; errors name
-/// the patches by their indices in the file.
-Surface loadSurface(const SurfaceSource& source);
+/// Adds --skip-faces alone (for commands that declare their own SURFACE).
+void addSkipFacesOption(CLI::App& command, SurfaceSource& source);
+
+/// The surface: the example if named, else the file (scallop::Error naming the file on bad
+/// input), reduced to the selected patches if any. A STEP or IGES file (cad_import.hpp's
+/// cadFormatOf: by extension, or by its first line) goes through scallop::cad, which
+/// validates every patch and names the face at fault; when `announce`, a line on stderr then
+/// says what was read: format, faces, patches, units, faces skipped. Any other file is JSON or
+/// .bpt; with a selection it is validated after the selection, so the patches not kept need
+/// not be regular; errors name the patches by their indices in the file.
+Surface loadSurface(const SurfaceSource& source, bool announce = true);
 
 /// How messages and reports name the surface: "example NAME", "<stdin>" or the path, followed
 /// by " (patches LIST)" when some are selected.

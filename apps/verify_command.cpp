@@ -40,6 +40,7 @@ struct VerifyOptions {
   std::string jsonPath;
   std::string svgPath;
   bool failOnGouge = false;
+  bool skipFaces = false;  // --skip-faces: a STEP or IGES file's unsupported faces
 };
 
 int runVerify(const VerifyOptions& options) {
@@ -52,6 +53,7 @@ int runVerify(const VerifyOptions& options) {
                                              ? "give SURFACE and PROGRAM (or --example NAME and PROGRAM)"
                                              : "with --example give only PROGRAM");
   if (expected == 2) source.input = options.files[0];
+  source.skipFaces = options.skipFaces;
   const std::string programPath = options.files.back();
 
   SimulationOptions simulation;
@@ -124,7 +126,7 @@ void addVerifyCommand(CLI::App& app, int& exitStatus) {
       "--fail-on-gouge when the deepest gouge exceeds the tolerance.\n"
       "Example: scallop plan --out out && scallop verify --example paper-1 out/toolpath.ngc --radius 0.25 "
       "--svg verify.svg");
-  verify->add_option("FILES", options->files, "[SURFACE] PROGRAM: the surface (JSON or .bpt; not with --example) and the G-code")
+  verify->add_option("FILES", options->files, "[SURFACE] PROGRAM: the surface (JSON, .bpt, STEP or IGES; not with --example) and the G-code")
       ->required()
       ->expected(1, 2)
       ->type_name("");
@@ -133,6 +135,8 @@ void addVerifyCommand(CLI::App& app, int& exitStatus) {
       ->type_name("NAME");
   verify->add_option("--patches", options->patches, "keep only these patches of the surface, e.g. 4 or 4-7,12")
       ->type_name("LIST");
+  verify->add_flag("--skip-faces", options->skipFaces,
+                   "STEP/IGES: leave out the faces that cannot be imported exactly, as plan --skip-faces");
   verify->add_option("--radius", options->radius, "ball radius R, in the surface's units")->required()->type_name("R");
   verify->add_option("--scallop-height", options->scallopHeight,
                      "scallop height H aimed at (default 0.001 in / 0.025 mm): grid spacing and uncut area")

@@ -13,8 +13,11 @@ build="${BUILD_DIR:-$root/build}"
 jobs="${JOBS:-$(nproc)}"
 
 # Debian packages scallop builds with (headers, CMake configs, test and bench frameworks).
+# OpenCASCADE 7.6 reads STEP and IGES (libocct-data-exchange-dev pulls the other OCCT toolkits
+# and occt-misc, whose sample parts the tests read); its CMake files name libtbb.so, which only
+# libtbb-dev provides (Debian 12's packages do not depend on it).
 packages=(build-essential cmake pkg-config nlohmann-json3-dev libfmt-dev libcli11-dev libboost-dev
-          libpolyclipping-dev libqhull-dev
+          libpolyclipping-dev libqhull-dev libocct-data-exchange-dev libtbb-dev
           libgtest-dev libgmock-dev libbenchmark-dev)
 # The tests check the G-code writer with LinuxCNC's own interpreter, rs274 (gcode_test.cpp
 # fails without it). It runs headless; with --no-install-recommends it still pulls in about

@@ -1,0 +1,777 @@
+// STEP and IGES faces to Bezier patches through OpenCASCADE (see cad_import.hpp). OCCT's
+// headers are confined to this file: the rest of scallop never sees them.
+
+#include "scallop/cad_import.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <mutex>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include <BRepTools.hxx>
+#include <BRep_Tool.hxx>
+#include <GeomAdaptor_Surface.hxx>
+#include <GeomConvert.hxx>
+#include <GeomConvert_BSplineSurfaceToBezierSurface.hxx>
+#include <Geom2d_BSplineCurve.hxx>
+#include <Geom2d_BezierCurve.hxx>
+#include <Geom2d_Curve.hxx>
+#include <Geom2d_Line.hxx>
+#include <Geom2d_TrimmedCurve.hxx>
+#include <Geom_BSplineCurve.hxx>
+#include <Geom_BSplineSurface.hxx>
+#include <Geom_BezierCurve.hxx>
+#include <Geom_BezierSurface.hxx>
+#include <Geom_Conic.hxx>
+#include <Geom_ConicalSurface.hxx>
+#include <Geom_CylindricalSurface.hxx>
+#include <Geom_Line.hxx>
+#include <Geom_OffsetSurface.hxx>
+#include <Geom_Plane.hxx>
+#include <Geom_RectangularTrimmedSurface.hxx>
+#include <Geom_SphericalSurface.hxx>
+#include <Geom_SurfaceOfLinearExtrusion.hxx>
+#include <Geom_SurfaceOfRevolution.hxx>
+#include <Geom_ToroidalSurface.hxx>
+#include <Geom_TrimmedCurve.hxx>
+#include <IGESControl_Reader.hxx>
+#include <IGESData_GlobalSection.hxx>
+#include <IGESData_IGESModel.hxx>
+#include <Interface_InterfaceModel.hxx>
+#include <Interface_Static.hxx>
+#include <Message.hxx>
+#include <Message_Messenger.hxx>
+#include <STEPControl_Reader.hxx>
+#include <Standard_Failure.hxx>
+#include <TColGeom_Array2OfBezierSurface.hxx>
+#include <TColStd_Array2OfReal.hxx>
+#include <TColStd_SequenceOfAsciiString.hxx>
+#include <TColgp_Array1OfPnt2d.hxx>
+#include <TColgp_Array2OfPnt.hxx>
+#include <TopExp_Explorer.hxx>
+#include <TopoDS.hxx>
+#include <TopoDS_Edge.hxx>
+#include <TopoDS_Face.hxx>
+#include <TopoDS_Iterator.hxx>
+#include <TopoDS_Shape.hxx>
+#include <TopoDS_Wire.hxx>
+#include <XSControl_TransferReader.hxx>
+#include <XSControl_WorkSession.hxx>
+
+#include "input_file.hpp"
+#include "scallop/error.hpp"
+
+namespace scallop {
+namespace {
+
+// Weights of one Bezier piece within this relative spread are one weight: the piece is
+// polynomial (knot insertion into equal weights rounds them by an ulp or two).
+constexpr double kEqualWeights = 1e-14;
+// The converted B-spline must reproduce the original surface to this fraction of the face's
+// size at the sample points: OCCT's exact conversions agree to rounding (~1e-15), its
+// approximations (1e-4 and coarser) do not.
+constexpr double kConversionTolerance = 1e-9;
+constexpr int kConversionSamples = 5;  // per direction
+
+// A face refused: the reason (without file and face) and its kind for the summary.
+struct FaceRefused {
+  CadFaceIssue issue;
+  std::string reason;
+};
+
+std::string lowerCase(std::string text) {
+  for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return text;
+}
+
+bool endsWith(const std::string& text, const std::string& tail) {
+  return text.size() >= tail.size() && text.compare(text.size() - tail.size(), tail.size(), tail) == 0;
+}
+
+// OCCT's console messages (transfer statistics, parse warnings) would mix with scallop's
+// output, JSON on standard output included: its default messenger's printers are taken away
+// for the call and given back after.
+class QuietMessages {
+ public:
+  QuietMessages() : messenger_(Message::DefaultMessenger()) {
+    if (messenger_.IsNull()) return;
+    saved_ = messenger_->Printers();
+    messenger_->ChangePrinters().Clear();
+  }
+  ~QuietMessages() {
+    if (!messenger_.IsNull()) messenger_->ChangePrinters() = saved_;
+  }
+  QuietMessages(const QuietMessages&) = delete;
+  QuietMessages& operator=(const QuietMessages&) = delete;
+
+ private:
+  Handle(Message_Messenger) messenger_;
+  Message_SequenceOfPrinters saved_;
+};
+
+// One of OCCT's process-wide reader parameters, set for the call and restored after, so that
+// the result does not depend on what the host program set (and the host's setting survives).
+class StaticParameter {
+ public:
+  StaticParameter(const char* name, const char* value) : name_(name) {
+    if (!Interface_Static::IsPresent(name)) return;
+    const char* old = Interface_Static::CVal(name);
+    if (old != nullptr) saved_ = old;
+    present_ = true;
+    Interface_Static::SetCVal(name, value);
+  }
+  ~StaticParameter() {
+    if (present_) Interface_Static::SetCVal(name_, saved_.c_str());
+  }
+  StaticParameter(const StaticParameter&) = delete;
+  StaticParameter& operator=(const StaticParameter&) = delete;
+
+ private:
+  const char* name_;
+  std::string saved_;
+  bool present_ = false;
+};
+
+// What OCCT says in an exception, for messages.
+std::string occtMessage(const Standard_Failure& failure) {
+  const char* text = failure.GetMessageString();
+  const std::string type = failure.DynamicType()->Name();
+  return (text != nullptr && *text != '\0') ? fmt::format("{}: {}", type, text) : type;
+}
+
+// --- the file before OCCT sees it ----------------------------------------------------------
+
+// The text without a UTF-8 byte order mark and leading blanks.
+std::string_view content(std::string_view text) {
+  if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);
+  while (!text.empty() && std::isspace(static_cast<unsigned char>(text.front()))) text.remove_prefix(1);
+  return text;
+}
+
+std::string quoted(std::string_view text) {
+  std::string shown(text.substr(0, 24));
+  for (char& c : shown)
+    if (!std::isprint(static_cast<unsigned char>(c))) c = '?';
+  return fmt::format("'{}{}'", shown, text.size() > 24 ? "..." : "");
+}
+
+// An IGES file's lines, without line ends.
+std::vector<std::string_view> lines(std::string_view text) {
+  std::vector<std::string_view> result;
+  while (!text.empty()) {
+    const std::size_t end = text.find('\n');
+    std::string_view line = text.substr(0, end);
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    result.push_back(line);
+    if (end == std::string_view::npos) break;
+    text.remove_prefix(end + 1);
+  }
+  while (!result.empty() && result.back().find_first_not_of(" \t") == std::string_view::npos) result.pop_back();
+  return result;
+}
+
+// The checks OCCT's parsers do not make (they read what they can of a truncated file and
+// transfer it): the header, and the end that only a complete file has.
+void checkText(const std::string& text, CadFormat format) {
+  if (text.empty()) throw Error("the file is empty");
+  const std::string_view body = content(text);
+  if (format == CadFormat::step) {
+    if (!body.starts_with("ISO-10303-21;"))
+      throw Error(fmt::format("not a STEP file: expected 'ISO-10303-21;' at the start, got {}", quoted(body)));
+    std::string_view tail = body;
+    while (!tail.empty() && std::isspace(static_cast<unsigned char>(tail.back()))) tail.remove_suffix(1);
+    if (!tail.ends_with("END-ISO-10303-21;"))
+      throw Error(fmt::format("truncated STEP file: it does not end with 'END-ISO-10303-21;' ({} bytes)", text.size()));
+    return;
+  }
+  // IGES: 80-column lines, the section letter in column 73: S(tart), G(lobal), D(irectory),
+  // P(arameter), T(erminate). The terminate line counts the lines of the other four.
+  const std::vector<std::string_view> all = lines(text);
+  if (all.empty() || all.front().size() < 73 || all.front()[72] != 'S')
+    throw Error(fmt::format("not an IGES file: expected a start line with 'S' in column 73, got {}",
+                            quoted(all.empty() ? std::string_view() : all.front())));
+  const std::string_view last = all.back();
+  if (last.size() < 73 || last[72] != 'T')
+    throw Error(fmt::format("truncated IGES file: its last line ({}) is not the terminate line ('T' in column 73)",
+                            all.size()));
+  std::array<std::size_t, 4> counted{};
+  constexpr std::string_view kSections = "SGDP";
+  for (const std::string_view line : all) {
+    if (line.size() < 73) continue;
+    const std::size_t s = kSections.find(line[72]);
+    if (s != std::string_view::npos) ++counted[s];
+  }
+  for (std::size_t s = 0; s < kSections.size(); ++s) {
+    // The terminate line: "S      1G      4D     26P     40", an 8-column field per section.
+    const std::size_t at = 8 * s;
+    if (last.size() < at + 8 || last[at] != kSections[s])
+      throw Error(fmt::format("malformed IGES terminate line {}", quoted(last)));
+    std::size_t declared = 0;
+    for (const char c : last.substr(at + 1, 7)) {
+      if (c == ' ') continue;
+      if (c < '0' || c > '9') throw Error(fmt::format("malformed IGES terminate line {}", quoted(last)));
+      declared = declared * 10 + static_cast<std::size_t>(c - '0');
+    }
+    if (declared != counted[s])
+      throw Error(fmt::format("truncated or damaged IGES file: the terminate line counts {} '{}' lines, the file has {}",
+                              declared, kSections[s], counted[s]));
+  }
+}
+
+// --- faces -----------------------------------------------------------------------------------
+
+const char* surfaceKind(const Handle(Geom_Surface)& surface) {
+  if (surface->IsKind(STANDARD_TYPE(Geom_Plane))) return "a plane";
+  if (surface->IsKind(STANDARD_TYPE(Geom_CylindricalSurface))) return "a cylinder";
+  if (surface->IsKind(STANDARD_TYPE(Geom_ConicalSurface))) return "a cone";
+  if (surface->IsKind(STANDARD_TYPE(Geom_SphericalSurface))) return "a sphere";
+  if (surface->IsKind(STANDARD_TYPE(Geom_ToroidalSurface))) return "a torus";
+  if (surface->IsKind(STANDARD_TYPE(Geom_BSplineSurface))) return "a B-spline surface";
+  if (surface->IsKind(STANDARD_TYPE(Geom_BezierSurface))) return "a Bezier surface";
+  if (surface->IsKind(STANDARD_TYPE(Geom_SurfaceOfLinearExtrusion))) return "an extrusion";
+  if (surface->IsKind(STANDARD_TYPE(Geom_SurfaceOfRevolution))) return "a surface of revolution";
+  if (surface->IsKind(STANDARD_TYPE(Geom_OffsetSurface))) return "an offset surface";
+  return surface->DynamicType()->Name();
+}
+
+// A curve OCCT converts to a B-spline exactly (GeomConvert::CurveToBSplineCurve is algebraic
+// for these; it approximates offset curves).
+bool exactCurve(Handle(Geom_Curve) curve) {
+  while (curve->IsKind(STANDARD_TYPE(Geom_TrimmedCurve)))
+    curve = Handle(Geom_TrimmedCurve)::DownCast(curve)->BasisCurve();
+  return curve->IsKind(STANDARD_TYPE(Geom_Line)) || curve->IsKind(STANDARD_TYPE(Geom_Conic)) ||
+         curve->IsKind(STANDARD_TYPE(Geom_BSplineCurve)) || curve->IsKind(STANDARD_TYPE(Geom_BezierCurve));
+}
+
+// The surface without rectangular trims (the face's UV rectangle trims it again) and with an
+// offset replaced by its exact equivalent; refused when OCCT could only approximate it.
+Handle(Geom_Surface) exactBasis(Handle(Geom_Surface) surface) {
+  for (;;) {
+    if (surface->IsKind(STANDARD_TYPE(Geom_RectangularTrimmedSurface))) {
+      surface = Handle(Geom_RectangularTrimmedSurface)::DownCast(surface)->BasisSurface();
+    } else if (surface->IsKind(STANDARD_TYPE(Geom_OffsetSurface))) {
+      const auto offset = Handle(Geom_OffsetSurface)::DownCast(surface);
+      Handle(Geom_Surface) equivalent = offset->Surface();
+      if (equivalent.IsNull())
+        throw FaceRefused{CadFaceIssue::unsupportedSurface,
+                          fmt::format("is an offset ({}) of {}, which has no exact B-spline form: offset "
+                                      "surfaces are not supported",
+                                      offset->Offset(), surfaceKind(offset->BasisSurface()))};
+      surface = equivalent;
+    } else {
+      break;
+    }
+  }
+  if (surface->IsKind(STANDARD_TYPE(Geom_SurfaceOfLinearExtrusion)) ||
+      surface->IsKind(STANDARD_TYPE(Geom_SurfaceOfRevolution))) {
+    const auto swept = Handle(Geom_SweptSurface)::DownCast(surface);
+    if (!exactCurve(swept->BasisCurve()))
+      throw FaceRefused{CadFaceIssue::unsupportedSurface,
+                        fmt::format("is {} of a {}, which has no exact B-spline form", surfaceKind(surface),
+                                    swept->BasisCurve()->DynamicType()->Name())};
+    return surface;
+  }
+  const bool known = surface->IsKind(STANDARD_TYPE(Geom_Plane)) || surface->IsKind(STANDARD_TYPE(Geom_CylindricalSurface)) ||
+                     surface->IsKind(STANDARD_TYPE(Geom_ConicalSurface)) || surface->IsKind(STANDARD_TYPE(Geom_SphericalSurface)) ||
+                     surface->IsKind(STANDARD_TYPE(Geom_ToroidalSurface)) || surface->IsKind(STANDARD_TYPE(Geom_BSplineSurface)) ||
+                     surface->IsKind(STANDARD_TYPE(Geom_BezierSurface));
+  if (!known)
+    throw FaceRefused{CadFaceIssue::unsupportedSurface, fmt::format("has an unsupported surface kind, {}", surfaceKind(surface))};
+  return surface;
+}
+
+// The face's parameter rectangle, when the face is one (see the contract's "trimming").
+struct Rectangle {
+  double u0, u1, v0, v1;
+  double tolU, tolV;  // parametric tolerances (the edges' 3D tolerance mapped to u and v)
+};
+
+// The points that decide where a pcurve lies: its poles (a B-spline or Bezier lies in their
+// convex hull) or, for a line, its ends; empty for any other curve.
+std::vector<gp_Pnt2d> decidingPoints(Handle(Geom2d_Curve) curve, double first, double last) {
+  while (curve->IsKind(STANDARD_TYPE(Geom2d_TrimmedCurve)))
+    curve = Handle(Geom2d_TrimmedCurve)::DownCast(curve)->BasisCurve();
+  std::vector<gp_Pnt2d> points;
+  if (curve->IsKind(STANDARD_TYPE(Geom2d_Line))) {
+    points = {curve->Value(first), curve->Value(last)};
+  } else if (curve->IsKind(STANDARD_TYPE(Geom2d_BSplineCurve))) {
+    // The edge may use part of the curve: the poles of that part decide.
+    const auto spline = Handle(Geom2d_BSplineCurve)::DownCast(curve->Copy());
+    const double lo = std::max(std::min(first, last), spline->FirstParameter());
+    const double hi = std::min(std::max(first, last), spline->LastParameter());
+    if ((lo > spline->FirstParameter() || hi < spline->LastParameter()) && hi - lo > Precision::PConfusion())
+      spline->Segment(lo, hi);
+    for (int i = 1; i <= spline->NbPoles(); ++i) points.push_back(spline->Pole(i));
+  } else if (curve->IsKind(STANDARD_TYPE(Geom2d_BezierCurve))) {
+    const auto bezier = Handle(Geom2d_BezierCurve)::DownCast(curve);
+    for (int i = 1; i <= bezier->NbPoles(); ++i) points.push_back(bezier->Pole(i));
+  }
+  return points;
+}
+
+Rectangle parameterRectangle(const TopoDS_Face& face, const Handle(Geom_Surface)& surface) {
+  int wires = 0;
+  for (TopoDS_Iterator it(face); it.More(); it.Next()) wires += it.Value().ShapeType() == TopAbs_WIRE ? 1 : 0;
+  if (wires != 1)
+    throw FaceRefused{CadFaceIssue::trimmed,
+                      wires == 0 ? std::string("is trimmed (no boundary wire): trimmed faces are not supported yet")
+                                 : fmt::format("is trimmed ({} wires: holes): trimmed faces are not supported yet", wires)};
+  struct EdgeOnSurface {
+    gp_Pnt2d first, last;
+    std::vector<gp_Pnt2d> deciding;
+    double tolerance;
+    std::string kind;  // the pcurve's OCCT type, for messages
+  };
+  std::vector<EdgeOnSurface> edges;
+  for (TopExp_Explorer it(face, TopAbs_EDGE); it.More(); it.Next()) {
+    const TopoDS_Edge& edge = TopoDS::Edge(it.Current());
+    double first = 0.0, last = 0.0;
+    const Handle(Geom2d_Curve) pcurve = BRep_Tool::CurveOnSurface(edge, face, first, last);
+    if (pcurve.IsNull())
+      throw FaceRefused{CadFaceIssue::trimmed, fmt::format("has an edge ({}) without a curve in its parameter "
+                                                           "plane: trimmed faces are not supported yet", edges.size())};
+    edges.push_back({pcurve->Value(first), pcurve->Value(last), decidingPoints(pcurve, first, last),
+                     BRep_Tool::Tolerance(edge), pcurve->DynamicType()->Name()});
+  }
+  if (edges.empty())
+    throw FaceRefused{CadFaceIssue::trimmed, "is trimmed (a wire without edges): trimmed faces are not supported yet"};
+  Rectangle r{edges[0].first.X(), edges[0].first.X(), edges[0].first.Y(), edges[0].first.Y(), 0.0, 0.0};
+  double tolerance3d = 0.0;
+  for (const EdgeOnSurface& e : edges) {
+    for (const gp_Pnt2d& p : {e.first, e.last}) {
+      r.u0 = std::min(r.u0, p.X());
+      r.u1 = std::max(r.u1, p.X());
+      r.v0 = std::min(r.v0, p.Y());
+      r.v1 = std::max(r.v1, p.Y());
+    }
+    tolerance3d = std::max(tolerance3d, e.tolerance);
+  }
+  const GeomAdaptor_Surface adaptor(surface);
+  r.tolU = std::max(Precision::PConfusion(), adaptor.UResolution(tolerance3d));
+  r.tolV = std::max(Precision::PConfusion(), adaptor.VResolution(tolerance3d));
+  // Each edge lies on one side; the sides' covered lengths add up (edges of a valid wire do
+  // not overlap).
+  std::array<double, 4> covered{};  // u = u0, u = u1, v = v0, v = v1
+  const std::array<const char*, 4> sideNames{"u = u0", "u = u1", "v = v0", "v = v1"};
+  for (std::size_t i = 0; i < edges.size(); ++i) {
+    const EdgeOnSurface& e = edges[i];
+    const auto all = [&](auto onSide) {
+      return !e.deciding.empty() && std::all_of(e.deciding.begin(), e.deciding.end(), onSide);
+    };
+    int side = -1;
+    if (all([&](const gp_Pnt2d& p) { return std::abs(p.X() - r.u0) <= r.tolU; })) side = 0;
+    else if (all([&](const gp_Pnt2d& p) { return std::abs(p.X() - r.u1) <= r.tolU; })) side = 1;
+    else if (all([&](const gp_Pnt2d& p) { return std::abs(p.Y() - r.v0) <= r.tolV; })) side = 2;
+    else if (all([&](const gp_Pnt2d& p) { return std::abs(p.Y() - r.v1) <= r.tolV; })) side = 3;
+    if (side < 0)
+      throw FaceRefused{CadFaceIssue::trimmed,
+                        fmt::format("is trimmed (edge {} of {}, a {} from ({:.6g}, {:.6g}) to ({:.6g}, {:.6g}), is not an "
+                                    "iso-line on a side of the rectangle [{:.6g}, {:.6g}] x [{:.6g}, {:.6g}] that the "
+                                    "edges' ends span): trimmed faces are not supported yet",
+                                    i, edges.size(), e.kind, e.first.X(), e.first.Y(), e.last.X(), e.last.Y(), r.u0,
+                                    r.u1, r.v0, r.v1)};
+    covered[static_cast<std::size_t>(side)] +=
+        side < 2 ? std::abs(e.last.Y() - e.first.Y()) : std::abs(e.last.X() - e.first.X());
+  }
+  for (std::size_t side = 0; side < 4; ++side) {
+    const double length = side < 2 ? r.v1 - r.v0 : r.u1 - r.u0;
+    const double tol = side < 2 ? r.tolV : r.tolU;
+    if (covered[side] < length - 2.0 * tol * static_cast<double>(edges.size()))
+      throw FaceRefused{CadFaceIssue::trimmed,
+                        fmt::format("is trimmed (its edges cover {:.6g} of the side {} of length {:.6g} of the parameter "
+                                    "rectangle): trimmed faces are not supported yet",
+                                    covered[side], sideNames[side], length)};
+  }
+  // A closed face of a periodic surface spans one period (its pcurves' ends may overshoot it
+  // by rounding, and OCCT would wrap the excess into an empty trim).
+  // Ends within tolerance of a multiple of the period are that multiple (the seam): OCCT's
+  // conversions of quadrics fail on a full turn starting at -2e-13.
+  const auto snapToPeriod = [](double& x, double period, double tol) {
+    const double k = std::round(x / period) * period;
+    if (std::abs(x - k) <= tol) x = k;
+  };
+  if (surface->IsUPeriodic()) {
+    snapToPeriod(r.u0, surface->UPeriod(), r.tolU);
+    snapToPeriod(r.u1, surface->UPeriod(), r.tolU);
+    if (r.u1 - r.u0 > surface->UPeriod() - r.tolU) r.u1 = r.u0 + surface->UPeriod();
+  }
+  if (surface->IsVPeriodic()) {
+    snapToPeriod(r.v0, surface->VPeriod(), r.tolV);
+    snapToPeriod(r.v1, surface->VPeriod(), r.tolV);
+    if (r.v1 - r.v0 > surface->VPeriod() - r.tolV) r.v1 = r.v0 + surface->VPeriod();
+  }
+  if (!(r.u1 - r.u0 > r.tolU) || !(r.v1 - r.v0 > r.tolV))
+    throw FaceRefused{CadFaceIssue::trimmed, fmt::format("has an empty parameter rectangle [{:.6g}, {:.6g}] x [{:.6g}, {:.6g}]",
+                                                         r.u0, r.u1, r.v0, r.v1)};
+  return r;
+}
+
+// The surface on the rectangle as a non-periodic B-spline, exactly (see the contract).
+Handle(Geom_BSplineSurface) bsplineOn(const Handle(Geom_Surface)& basis, const Rectangle& r) {
+  Handle(Geom_BSplineSurface) spline;
+  if (basis->IsKind(STANDARD_TYPE(Geom_BSplineSurface))) {
+    spline = Handle(Geom_BSplineSurface)::DownCast(basis->Copy());
+  } else if (basis->IsKind(STANDARD_TYPE(Geom_BezierSurface))) {
+    spline = GeomConvert::SurfaceToBSplineSurface(basis);
+  } else {
+    // Unbounded or periodic kinds: trimmed to the face first, so the conversion is bounded.
+    spline = GeomConvert::SurfaceToBSplineSurface(new Geom_RectangularTrimmedSurface(basis, r.u0, r.u1, r.v0, r.v1));
+  }
+  const bool converted =
+      !basis->IsKind(STANDARD_TYPE(Geom_BSplineSurface)) && !basis->IsKind(STANDARD_TYPE(Geom_BezierSurface));
+  if (converted) {
+    if (spline->IsUPeriodic()) spline->SetUNotPeriodic();
+    if (spline->IsVPeriodic()) spline->SetVNotPeriodic();
+    return spline;  // converted on the rectangle already
+  }
+  // A periodic direction: a face around the whole period is the whole closed surface (wherever
+  // its seam), one period's copy; a face on part of it may cross the seam, so it is cut out of
+  // the periodic surface itself (Segment works across the seam).
+  double u0 = r.u0, u1 = r.u1, v0 = r.v0, v1 = r.v1;
+  const bool fullU = spline->IsUPeriodic() && u1 - u0 >= spline->UPeriod() - r.tolU;
+  const bool fullV = spline->IsVPeriodic() && v1 - v0 >= spline->VPeriod() - r.tolV;
+  if (fullU) spline->SetUNotPeriodic();
+  if (fullV) spline->SetVNotPeriodic();
+  double bu0 = 0.0, bu1 = 0.0, bv0 = 0.0, bv1 = 0.0;
+  spline->Bounds(bu0, bu1, bv0, bv1);
+  // Ends within tolerance of (or, by a pcurve's rounding, beyond) the surface's are the
+  // surface's: no sliver patch. Ends inside are snapped to knots by Segment's tolerances.
+  const auto snap = [](double& lo, double& hi, double first, double last, double tol, bool periodic) {
+    if (periodic) {
+      if (std::abs(lo - first) <= tol) lo = first;
+      if (std::abs(hi - last) <= tol) hi = last;
+      return;
+    }
+    if (lo - first <= tol) lo = first;
+    if (last - hi <= tol) hi = last;
+  };
+  snap(u0, u1, bu0, bu1, r.tolU, spline->IsUPeriodic());
+  snap(v0, v1, bv0, bv1, r.tolV, spline->IsVPeriodic());
+  if (fullU) u0 = bu0, u1 = bu1;
+  if (fullV) v0 = bv0, v1 = bv1;
+  if (spline->IsUPeriodic() || spline->IsVPeriodic() || u0 != bu0 || u1 != bu1 || v0 != bv0 || v1 != bv1)
+    spline->Segment(u0, u1, v0, v1, r.tolU, r.tolV);
+  if (spline->IsUPeriodic()) spline->SetUNotPeriodic();
+  if (spline->IsVPeriodic()) spline->SetVNotPeriodic();
+  return spline;
+}
+
+struct Weights {
+  double min = 1.0, max = 1.0;
+  bool polynomial() const { return max - min <= kEqualWeights * max; }
+};
+
+Weights weightsOf(const Handle(Geom_BezierSurface)& piece) {
+  Weights w;
+  if (!piece->IsURational() && !piece->IsVRational()) return w;
+  TColStd_Array2OfReal weights(1, piece->NbUPoles(), 1, piece->NbVPoles());
+  piece->Weights(weights);
+  w.min = w.max = weights(1, 1);
+  for (int i = 1; i <= piece->NbUPoles(); ++i)
+    for (int j = 1; j <= piece->NbVPoles(); ++j) {
+      w.min = std::min(w.min, weights(i, j));
+      w.max = std::max(w.max, weights(i, j));
+    }
+  return w;
+}
+
+// The largest distance between the spline and the original surface at a grid of the
+// rectangle, relative to the size of the spline's control net.
+void checkConversion(const Handle(Geom_Surface)& original, const Handle(Geom_BSplineSurface)& spline, const Rectangle& r) {
+  double size = 0.0;
+  {
+    const TColgp_Array2OfPnt& poles = spline->Poles();
+    gp_XYZ lo = poles(poles.LowerRow(), poles.LowerCol()).XYZ(), hi = lo;
+    for (int i = poles.LowerRow(); i <= poles.UpperRow(); ++i)
+      for (int j = poles.LowerCol(); j <= poles.UpperCol(); ++j) {
+        const gp_XYZ p = poles(i, j).XYZ();
+        lo.SetCoord(std::min(lo.X(), p.X()), std::min(lo.Y(), p.Y()), std::min(lo.Z(), p.Z()));
+        hi.SetCoord(std::max(hi.X(), p.X()), std::max(hi.Y(), p.Y()), std::max(hi.Z(), p.Z()));
+      }
+    size = (hi - lo).Modulus();
+  }
+  double su0 = 0.0, su1 = 0.0, sv0 = 0.0, sv1 = 0.0;
+  spline->Bounds(su0, su1, sv0, sv1);
+  double worst = 0.0;
+  for (int a = 0; a < kConversionSamples; ++a)
+    for (int b = 0; b < kConversionSamples; ++b) {
+      const double s = (a + 0.5) / kConversionSamples, t = (b + 0.5) / kConversionSamples;
+      const gp_Pnt expected = original->Value(r.u0 + s * (r.u1 - r.u0), r.v0 + t * (r.v1 - r.v0));
+      const gp_Pnt got = spline->Value(su0 + s * (su1 - su0), sv0 + t * (sv1 - sv0));
+      worst = std::max(worst, expected.Distance(got));
+    }
+  if (!(worst <= kConversionTolerance * size))
+    throw FaceRefused{CadFaceIssue::unsupportedSurface,
+                      fmt::format("is {}, whose conversion to a B-spline is not exact (off by {:.3g}, {:.3g} of its size): not supported",
+                                  surfaceKind(original), worst, size > 0.0 ? worst / size : worst)};
+}
+
+// What facePatches is doing, for the message when OCCT throws.
+struct Stage {
+  const char* what = "reading the face";
+  std::optional<Rectangle> rectangle;  // once known
+};
+
+std::vector<BezierPatch> facePatches(const TopoDS_Face& face, Units units, Stage& stage) {
+  const Handle(Geom_Surface) located = BRep_Tool::Surface(face);  // the face's location applied
+  if (located.IsNull()) throw FaceRefused{CadFaceIssue::unsupportedSurface, "has no surface"};
+  const Handle(Geom_Surface) basis = exactBasis(located);
+  stage.what = "checking its boundary";
+  const Rectangle rectangle = parameterRectangle(face, basis);
+  stage.what = "converting it to a B-spline";
+  stage.rectangle = rectangle;
+  const Handle(Geom_BSplineSurface) spline = bsplineOn(basis, rectangle);
+  stage.what = "splitting it into Bezier pieces";
+  GeomConvert_BSplineSurfaceToBezierSurface splitter(spline);
+  TColGeom_Array2OfBezierSurface pieces(1, splitter.NbUPatches(), 1, splitter.NbVPatches());
+  splitter.Patches(pieces);
+
+  Weights range;
+  range.min = range.max = weightsOf(pieces(1, 1)).min;
+  bool polynomial = true;
+  for (int i = 1; i <= pieces.UpperRow(); ++i)
+    for (int j = 1; j <= pieces.UpperCol(); ++j) {
+      const Weights w = weightsOf(pieces(i, j));
+      polynomial = polynomial && w.polynomial();
+      range.min = std::min(range.min, w.min);
+      range.max = std::max(range.max, w.max);
+    }
+  if (!polynomial)
+    throw FaceRefused{CadFaceIssue::rational,
+                      fmt::format("is rational (weights {:.6g} to {:.6g}, {}): rational faces are not supported yet",
+                                  range.min, range.max, surfaceKind(basis))};
+  stage.what = "checking the conversion";
+  checkConversion(basis, spline, rectangle);
+
+  const bool reversed = face.Orientation() == TopAbs_REVERSED;
+  std::vector<BezierPatch> patches;
+  for (int i = 1; i <= pieces.UpperRow(); ++i)
+    for (int j = 1; j <= pieces.UpperCol(); ++j) {
+      const Handle(Geom_BezierSurface)& piece = pieces(i, j);
+      BezierPatch patch;
+      patch.degreeU = piece->UDegree();
+      patch.degreeV = piece->VDegree();
+      patch.control.reserve(static_cast<std::size_t>((patch.degreeU + 1) * (patch.degreeV + 1)));
+      for (int a = 0; a <= patch.degreeU; ++a)
+        for (int b = 0; b <= patch.degreeV; ++b) {
+          // Reversing u flips r_u and so r_u x r_v: the normal then points out of the material.
+          const gp_Pnt& p = piece->Pole(reversed ? patch.degreeU - a + 1 : a + 1, b + 1);
+          patch.control.push_back({p.X(), p.Y(), p.Z()});
+        }
+      patches.push_back(std::move(patch));
+    }
+  try {
+    validateSurface(Surface{units, patches});
+  } catch (const Error& error) {
+    std::string message = error.what();
+    if (message.starts_with("patches[")) message = "piece " + message.substr(8);  // "patches[i]..." of this face
+    throw FaceRefused{CadFaceIssue::invalidPatch, fmt::format("has an invalid Bezier {} ({}, {} pieces)", message,
+                                                              surfaceKind(basis), patches.size())};
+  }
+  return patches;
+}
+
+// "#123" (STEP) or "D45" (IGES): the face's entity in the file, where OCCT's transfer
+// records it; empty otherwise (shape healing may have replaced the face).
+std::string entityLabel(const Handle(XSControl_WorkSession)& session, const TopoDS_Face& face) {
+  try {
+    const Handle(XSControl_TransferReader) transfer = session->TransferReader();
+    if (transfer.IsNull()) return {};
+    Handle(Standard_Transient) entity = transfer->EntityFromShapeResult(face, 1);
+    if (entity.IsNull()) entity = transfer->EntityFromShapeResult(face, -1);
+    if (entity.IsNull() || session->Model().IsNull()) return {};
+    const Handle(TCollection_HAsciiString) label = session->Model()->StringLabel(entity);
+    return label.IsNull() ? std::string() : std::string(label->ToCString());
+  } catch (const Standard_Failure&) {
+    return {};
+  }
+}
+
+// The transferred shape and what the file says of its units.
+struct Transferred {
+  TopoDS_Shape shape;
+  Units units = Units::millimetre;
+  std::string fileUnit;
+  Handle(XSControl_WorkSession) session;
+  int roots = 0;
+};
+
+Transferred readStep(const std::string& path) {
+  STEPControl_Reader reader;
+  StaticParameter unit("xstep.cascade.unit", "MM");
+  if (reader.ReadFile(path.c_str()) != IFSelect_RetDone)
+    throw Error("OpenCASCADE cannot parse it as STEP (damaged or not ISO 10303-21)");
+  Transferred result;
+  TColStd_SequenceOfAsciiString lengths, angles, solidAngles;
+  reader.FileUnits(lengths, angles, solidAngles);
+  bool inch = lengths.Length() > 0;
+  for (int i = 1; i <= lengths.Length(); ++i) {
+    const std::string name = lengths(i).ToCString();
+    if (result.fileUnit.find(name) == std::string::npos)
+      result.fileUnit += (result.fileUnit.empty() ? "" : ",") + name;
+    inch = inch && lowerCase(name) == "inch";
+  }
+  result.units = inch ? Units::inch : Units::millimetre;
+  // The system unit is the length unit of the shapes OCCT builds, in millimetres.
+  reader.SetSystemLengthUnit(inch ? 25.4 : 1.0);
+  result.roots = reader.NbRootsForTransfer();
+  reader.TransferRoots();
+  result.shape = reader.OneShape();
+  result.session = reader.WS();
+  return result;
+}
+
+Transferred readIges(const std::string& path) {
+  IGESControl_Reader reader;
+  StaticParameter unit("xstep.cascade.unit", "MM");
+  // OCCT's default (1) raises C0 B-spline surfaces to C1 by removing knots within tolerance:
+  // an approximation. 0 keeps them as written.
+  StaticParameter continuity("read.iges.bspline.continuity", "0");
+  if (reader.ReadFile(path.c_str()) != IFSelect_RetDone) throw Error("OpenCASCADE cannot parse it as IGES (damaged)");
+  Transferred result;
+  const auto model = Handle(IGESData_IGESModel)::DownCast(reader.Model());
+  if (model.IsNull()) throw Error("OpenCASCADE cannot parse it as IGES (no model)");
+  IGESData_GlobalSection global = model->GlobalSection();
+  const Handle(TCollection_HAsciiString) unitName = global.UnitName();
+  result.fileUnit = unitName.IsNull() ? fmt::format("flag {}", global.UnitFlag()) : std::string(unitName->ToCString());
+  // Unit flag 1 is the inch (IGES 5.3, global parameter 14); flag 3 names the unit in
+  // parameter 15. OCCT scales the file's lengths to the "cascade unit" (millimetres per unit)
+  // recorded in the model at parse time.
+  const std::string named = unitName.IsNull() ? std::string() : lowerCase(unitName->ToCString());
+  const bool inch = global.UnitFlag() == 1 || (global.UnitFlag() == 3 && (named == "in" || named == "inch"));
+  result.units = inch ? Units::inch : Units::millimetre;
+  global.SetCascadeUnit(inch ? 25.4 : 1.0);
+  model->SetGlobalSection(global);
+  result.roots = reader.NbRootsForTransfer();
+  reader.TransferRoots();
+  result.shape = reader.OneShape();
+  result.session = reader.WS();
+  return result;
+}
+
+std::string faceName(std::size_t index, const std::string& label) {
+  return label.empty() ? fmt::format("face {}", index) : fmt::format("face {} ({})", index, label);
+}
+
+std::mutex& importMutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+
+}  // namespace
+
+std::string_view cadFormatName(CadFormat format) { return format == CadFormat::step ? "STEP" : "IGES"; }
+
+std::string_view cadFaceIssueName(CadFaceIssue issue) {
+  switch (issue) {
+    case CadFaceIssue::rational: return "rational";
+    case CadFaceIssue::trimmed: return "trimmed";
+    case CadFaceIssue::unsupportedSurface: return "unsupported surface";
+    case CadFaceIssue::invalidPatch: return "invalid patch";
+  }
+  return "unknown";
+}
+
+std::optional<CadFormat> cadFormatOf(const std::string& path) {
+  if (path == "-") return std::nullopt;
+  const std::string lower = lowerCase(path);
+  if (endsWith(lower, ".step") || endsWith(lower, ".stp")) return CadFormat::step;
+  if (endsWith(lower, ".iges") || endsWith(lower, ".igs")) return CadFormat::iges;
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (file == nullptr) return std::nullopt;
+  char buffer[256];
+  const std::size_t count = std::fread(buffer, 1, sizeof buffer, file);
+  std::fclose(file);
+  const std::string_view raw(buffer, count);
+  if (content(raw).starts_with("ISO-10303-21;")) return CadFormat::step;
+  // IGES's start line is blank up to its text: no blanks skipped.
+  const std::string_view first = raw.substr(0, raw.find('\n'));
+  if (first.size() >= 73 && first[72] == 'S' && (first.size() == 80 || (first.size() == 81 && first.back() == '\r')))
+    return CadFormat::iges;
+  return std::nullopt;
+}
+
+CadImport importCad(const std::string& path, const CadImportOptions& options) {
+  const std::optional<CadFormat> format = cadFormatOf(path);
+  if (!format) throw Error(fmt::format("{}: not a STEP or IGES file (by its name or its first line)", path));
+  return importCad(path, *format, options);
+}
+
+CadImport importCad(const std::string& path, CadFormat format, const CadImportOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  std::string text;
+  try {
+    text = detail::readInputFile(path);
+  } catch (const Error& error) {
+    throw Error(fmt::format("{}: {}", path, error.what()));
+  }
+  try {
+    checkText(text, format);
+  } catch (const Error& error) {
+    throw Error(fmt::format("{}: {}", path, error.what()));
+  }
+  text.clear();
+  text.shrink_to_fit();
+
+  const std::lock_guard<std::mutex> lock(importMutex());
+  const QuietMessages quiet;
+  CadImport result;
+  result.format = format;
+  Transferred transferred;
+  try {
+    transferred = format == CadFormat::step ? readStep(path) : readIges(path);
+  } catch (const Error& error) {
+    throw Error(fmt::format("{}: {}", path, error.what()));
+  } catch (const Standard_Failure& failure) {
+    throw Error(fmt::format("{}: OpenCASCADE failed to read it as {} ({})", path, cadFormatName(format), occtMessage(failure)));
+  }
+  result.surface.units = transferred.units;
+  result.fileUnit = transferred.fileUnit;
+
+  std::size_t index = 0;
+  for (TopExp_Explorer it(transferred.shape, TopAbs_FACE); it.More(); it.Next(), ++index) {
+    const TopoDS_Face& face = TopoDS::Face(it.Current());
+    try {
+      std::vector<BezierPatch> patches;
+      Stage stage;
+      try {
+        patches = facePatches(face, transferred.units, stage);
+      } catch (const Standard_Failure& failure) {
+        throw FaceRefused{CadFaceIssue::unsupportedSurface,
+                          fmt::format("could not be converted: OpenCASCADE failed {}{} ({})", stage.what,
+                                      stage.rectangle ? fmt::format(" on [{:.17g}, {:.17g}] x [{:.17g}, {:.17g}]",
+                                                                    stage.rectangle->u0, stage.rectangle->u1,
+                                                                    stage.rectangle->v0, stage.rectangle->v1)
+                                                      : std::string(),
+                                      occtMessage(failure))};
+      }
+      for (BezierPatch& patch : patches) {
+        result.surface.patches.push_back(std::move(patch));
+        result.patchFaces.push_back(index);
+      }
+    } catch (const FaceRefused& refused) {
+      const std::string name = faceName(index, entityLabel(transferred.session, face));
+      if (!options.skipUnsupportedFaces) throw Error(fmt::format("{}: {} {}", path, name, refused.reason));
+      result.skipped.push_back({index, refused.issue, fmt::format("{} {}", name, refused.reason)});
+    }
+  }
+  result.faces = index;
+  if (index == 0)
+    throw Error(fmt::format("{}: no faces in the file ({} root entities transferred): nothing to machine", path,
+                            transferred.roots));
+  if (result.surface.patches.empty())
+    throw Error(fmt::format("{}: none of its {} faces can be imported exactly; the first: {}", path, index,
+                            result.skipped.front().reason));
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+}  // namespace scallop
