@@ -4,6 +4,8 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <functional>
+#include <memory>
 #include <limits>
 #include <numbers>
 #include <queue>
@@ -440,22 +442,14 @@ double sweptBallLowest(const SweptMove& move, double toolRadius, double x, doubl
   return MoveShape(move, toolRadius).lowest(x, y);
 }
 
-HeightGrid simulationGrid(const Surface& surface, const SimulationOptions& options) {
-  validateOptions(options);
-  if (surface.patches.empty()) throw Error("the surface has no patches");
+namespace {
+
+// The contract's grid over the xy box [xlo, xhi] x [ylo, yhi] (options validated).
+HeightGrid gridOver(double xlo, double xhi, double ylo, double yhi, const SimulationOptions& options) {
   const double radius = options.toolRadius, height = options.scallopHeight;
   const double spacing = options.resolution > 0.0 ? options.resolution
                                                   : height / (2.0 * flankSlope(radius, height));
   const double margin = std::isnan(options.margin) ? 2.0 * spacing : options.margin;
-  double xlo = kInf, xhi = -kInf, ylo = kInf, yhi = -kInf;
-  for (const BezierPatch& patch : surface.patches) {
-    for (const Vec3& c : patch.control) {
-      xlo = std::min(xlo, c.x);
-      xhi = std::max(xhi, c.x);
-      ylo = std::min(ylo, c.y);
-      yhi = std::max(yhi, c.y);
-    }
-  }
   HeightGrid grid;
   grid.spacing = spacing;
   grid.x0 = xlo - margin;
@@ -474,6 +468,36 @@ HeightGrid simulationGrid(const Surface& surface, const SimulationOptions& optio
   return grid;
 }
 
+}  // namespace
+
+HeightGrid simulationGrid(const Surface& surface, const SimulationOptions& options) {
+  validateOptions(options);
+  if (surface.patches.empty()) throw Error("the surface has no patches");
+  double xlo = kInf, xhi = -kInf, ylo = kInf, yhi = -kInf;
+  for (const BezierPatch& patch : surface.patches) {
+    for (const Vec3& c : patch.control) {
+      xlo = std::min(xlo, c.x);
+      xhi = std::max(xhi, c.x);
+      ylo = std::min(ylo, c.y);
+      yhi = std::max(yhi, c.y);
+    }
+  }
+  return gridOver(xlo, xhi, ylo, yhi, options);
+}
+
+HeightGrid simulationGrid(const Mesh& mesh, const SimulationOptions& options) {
+  validateOptions(options);
+  if (mesh.triangles.empty()) throw Error("the mesh has no triangles");
+  double xlo = kInf, xhi = -kInf, ylo = kInf, yhi = -kInf;
+  for (const Vec3& v : mesh.vertices) {
+    xlo = std::min(xlo, v.x);
+    xhi = std::max(xhi, v.x);
+    ylo = std::min(ylo, v.y);
+    yhi = std::max(yhi, v.y);
+  }
+  return gridOver(xlo, xhi, ylo, yhi, options);
+}
+
 void designHeights(const Surface& surface, HeightGrid& grid, std::vector<double>* normalZ) {
   std::fill(grid.z.begin(), grid.z.end(), -kInf);
   if (normalZ) normalZ->assign(grid.z.size(), 0.0);
@@ -483,6 +507,44 @@ void designHeights(const Surface& surface, HeightGrid& grid, std::vector<double>
     const Bernstein2 jacobian = subtract(multiply(derivativeU(r[0]), derivativeV(r[1])),
                                          multiply(derivativeV(r[0]), derivativeU(r[1])));
     designCell(DesignPatch{patch, jacobian, tolerance}, 0.0, 1.0, 0.0, 1.0, 0, grid, normalZ);
+  }
+}
+
+void designHeights(const Mesh& mesh, HeightGrid& grid, std::vector<double>* normalZ) {
+  std::fill(grid.z.begin(), grid.z.end(), -kInf);
+  if (normalZ) normalZ->assign(grid.z.size(), 0.0);
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const auto& tri = mesh.triangles[t];
+    const Vec3 a = mesh.vertices[tri[0]], b = mesh.vertices[tri[1]], c = mesh.vertices[tri[2]];
+    const Vec3 n = cross(b - a, c - a);
+    // A vertical triangle shows from above only along its top edge, which its neighbours
+    // share; twice its projected area is n_z, so one of no area adds no grid point.
+    if (n.z == 0.0) continue;
+    const double nz = std::abs(n.z) / norm(n);
+    const auto [is, js] = std::pair{
+        indexRange(std::min({a.x, b.x, c.x}), std::max({a.x, b.x, c.x}), grid.x0, grid.spacing, grid.columns),
+        indexRange(std::min({a.y, b.y, c.y}), std::max({a.y, b.y, c.y}), grid.y0, grid.spacing, grid.rows)};
+    if (is.empty() || js.empty()) continue;
+    for (std::size_t j = js.lo; j <= js.hi; ++j) {
+      for (std::size_t i = is.lo; i <= is.hi; ++i) {
+        const Vec2 p = grid.point(i, j);
+        // Barycentric coordinates in the xy projection. A point on an edge belongs to both
+        // triangles, and to the footprint where the edge is its boundary: the coordinates'
+        // rounding (a few ulps) must not drop it, so they may fall 1e-12 below 0 (the height
+        // is then extrapolated by at most 1e-12 of the triangle's rise).
+        const double wa = ((b.x - p.x) * (c.y - p.y) - (b.y - p.y) * (c.x - p.x)) / n.z;
+        const double wb = ((c.x - p.x) * (a.y - p.y) - (c.y - p.y) * (a.x - p.x)) / n.z;
+        const double wc = 1.0 - wa - wb;
+        constexpr double kEdgeSlack = -1e-12;
+        if (wa < kEdgeSlack || wb < kEdgeSlack || wc < kEdgeSlack) continue;
+        const double z = wa * a.z + wb * b.z + wc * c.z;
+        double& top = grid.z[j * grid.columns + i];
+        if (z > top) {
+          top = z;
+          if (normalZ) (*normalZ)[j * grid.columns + i] = nz;
+        }
+      }
+    }
   }
 }
 
@@ -533,24 +595,71 @@ std::size_t sweepMoves(const std::vector<SweptMove>& moves, double toolRadius, H
   return visits;
 }
 
+namespace {
+
+// Makes, per thread, a test of whether the ball can reach a surface point q left above H
+// (true: it cannot; see the contract's Reach); none: no classification.
+using ReachTestFactory = std::function<std::function<bool(Vec3)>()>;
+
+// A report's figures before the design: units, tool, grid, tolerances, the stock's top.
+SimulationReport reportFor(Units units, HeightGrid grid, double highest, const SimulationOptions& options) {
+  SimulationReport report;
+  report.units = units;
+  report.toolRadius = options.toolRadius;
+  report.scallopHeight = options.scallopHeight;
+  report.design = std::move(grid);
+  report.gougeTolerance = std::isnan(options.gougeTolerance) ? defaultGougeTolerance(units) : options.gougeTolerance;
+  report.heightErrorBound = 0.5 * flankSlope(options.toolRadius, options.scallopHeight) * report.design.spacing;
+  report.stockTop = options.stockTop.value_or(highest);
+  return report;
+}
+
+// The sweep and the comparison on a report whose design grid, normals, stock top and
+// tolerances are set.
+void sweepAndCompare(SimulationReport& report, const std::vector<SweptMove>& moves, const SimulationOptions& options,
+                     const ReachTestFactory& reachTest, std::chrono::steady_clock::time_point start);
+
+}  // namespace
+
 SimulationReport simulateCut(const Surface& surface, const std::vector<SweptMove>& moves,
                              const SimulationOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  SimulationReport report;
-  report.units = surface.units;
-  report.toolRadius = options.toolRadius;
-  report.scallopHeight = options.scallopHeight;
-  report.design = simulationGrid(surface, options);
-  report.gougeTolerance = std::isnan(options.gougeTolerance) ? defaultGougeTolerance(surface.units) : options.gougeTolerance;
-  report.heightErrorBound = 0.5 * flankSlope(options.toolRadius, options.scallopHeight) * report.design.spacing;
   double top = -kInf;
   for (const BezierPatch& patch : surface.patches)
     for (const Vec3& c : patch.control) top = std::max(top, c.z);
-  report.stockTop = options.stockTop.value_or(top);
-
+  SimulationReport report = reportFor(surface.units, simulationGrid(surface, options), top, options);
   designHeights(surface, report.design, &report.designNormalZ);
   report.designSeconds = secondsSince(start);
+  std::shared_ptr<const SurfaceDistance> distance;
+  if (options.classifyReach) distance = std::make_shared<const SurfaceDistance>(surface);
+  const double radius = options.toolRadius, height = options.scallopHeight;
+  sweepAndCompare(report, moves, options,
+                  [&]() -> std::function<bool(Vec3)> {
+                    auto cutter = std::make_shared<DropCutter>(*distance, radius);
+                    return [distance, cutter, radius, height](Vec3 q) {
+                      const ReachWitness witness = reachWitness(*distance, *cutter, q, radius);
+                      return witness.centre && witness.gap > height;
+                    };
+                  },
+                  start);
+  return report;
+}
 
+SimulationReport simulateCut(const Mesh& mesh, const std::vector<SweptMove>& moves, const SimulationOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  double top = -kInf;
+  for (const Vec3& v : mesh.vertices) top = std::max(top, v.z);
+  SimulationReport report = reportFor(mesh.units, simulationGrid(mesh, options), top, options);
+  designHeights(mesh, report.design, &report.designNormalZ);
+  report.designSeconds = secondsSince(start);
+  sweepAndCompare(report, moves, options, nullptr, start);
+  return report;
+}
+
+namespace {
+
+void sweepAndCompare(SimulationReport& report, const std::vector<SweptMove>& moves, const SimulationOptions& options,
+                     const ReachTestFactory& reachTest, std::chrono::steady_clock::time_point start) {
   const auto sweepStart = std::chrono::steady_clock::now();
   report.stock = report.design;
   const double evaluations = sweepEvaluations(moves, options.toolRadius, report.stock);
@@ -602,21 +711,17 @@ SimulationReport simulateCut(const Surface& surface, const std::vector<SweptMove
   }
   // Which of the points left above H the ball can reach at all (see the contract).
   report.unreachable.assign(design.z.size(), 0);
-  if (options.classifyReach && !uncut.empty()) {
+  if (options.classifyReach && reachTest && !uncut.empty()) {
     const auto reachStart = std::chrono::steady_clock::now();
     const std::size_t checks = std::min(uncut.size(), options.maxReachChecks);
     report.reachChecks = checks;
     report.reachBudgetExhausted = checks < uncut.size();
-    const SurfaceDistance distance(surface);
-    const double radius = options.toolRadius;
     const auto classify = [&](std::size_t from, std::size_t to) {
-      DropCutter cutter(distance, radius);
+      const std::function<bool(Vec3)> beyondReach = reachTest();
       for (std::size_t k = from; k < to; ++k) {
         const std::size_t index = uncut[k];
         const Vec2 p = design.point(index % design.columns, index / design.columns);
-        const Vec3 q{p.x, p.y, design.z[index]};
-        const ReachWitness witness = reachWitness(distance, cutter, q, radius);
-        if (witness.centre && witness.gap > options.scallopHeight) report.unreachable[index] = 1;
+        if (beyondReach(Vec3{p.x, p.y, design.z[index]})) report.unreachable[index] = 1;
       }
     };
     const std::size_t threads =
@@ -667,8 +772,9 @@ SimulationReport simulateCut(const Surface& surface, const std::vector<SweptMove
   report.uncutArea = static_cast<double>(report.uncutPoints) * cellArea;
   report.unreachableArea = static_cast<double>(report.unreachablePoints) * cellArea;
   report.seconds = secondsSince(start);
-  return report;
 }
+
+}  // namespace
 
 ReachWitness reachWitness(const SurfaceDistance& distance, DropCutter& cutter, Vec3 q, double radius) {
   const ClosestPoint foot = distance.closest(q);
@@ -685,15 +791,29 @@ ReachWitness reachWitness(const SurfaceDistance& distance, DropCutter& cutter, V
   return out;
 }
 
+namespace {
+
+void requireUnits(const GcodeProgram& program, Units units, const char* what) {
+  if (program.units != units)
+    throw Error(fmt::format("{}: the program is in {} ({}) but the {} in {}", program.sourceName,
+                            program.units == Units::inch ? "inches" : "millimetres",
+                            program.units == Units::inch ? "G20" : "G21", what,
+                            units == Units::inch ? "inches" : "millimetres"));
+}
+
+}  // namespace
+
 SimulationReport verifyProgram(const Surface& surface, const GcodeProgram& program,
                                const SimulationOptions& options) {
-  if (program.units != surface.units)
-    throw Error(fmt::format("{}: the program is in {} ({}) but the surface in {}", program.sourceName,
-                            program.units == Units::inch ? "inches" : "millimetres",
-                            program.units == Units::inch ? "G20" : "G21",
-                            surface.units == Units::inch ? "inches" : "millimetres"));
+  requireUnits(program, surface.units, "surface");
   validateOptions(options);
   return simulateCut(surface, sweptMoves(program, options.toolRadius), options);
+}
+
+SimulationReport verifyProgram(const Mesh& mesh, const GcodeProgram& program, const SimulationOptions& options) {
+  requireUnits(program, mesh.units, "mesh");
+  validateOptions(options);
+  return simulateCut(mesh, sweptMoves(program, options.toolRadius), options);
 }
 
 SimulationReport verifyToolPath(const Surface& surface, const ToolPath& path, SimulationOptions options) {

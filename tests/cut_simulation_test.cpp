@@ -1083,3 +1083,150 @@ TEST(CutSimulationReach, NothingIsUnreachableOnAPlaneOrAConvexDome) {
 
 }  // namespace
 }  // namespace scallop
+
+// ---------------------------------------------------------------------------------------
+// Meshes (the contract's Meshes)
+// ---------------------------------------------------------------------------------------
+
+namespace scallop {
+namespace {
+
+// A height field z = f(x, y) on an n x n grid of [0, 2]^2, each cell split along a random
+// diagonal.
+Mesh heightFieldMesh(std::size_t n, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  Mesh mesh;
+  mesh.units = Units::inch;
+  for (std::size_t j = 0; j <= n; ++j)
+    for (std::size_t i = 0; i <= n; ++i) {
+      const double x = 2.0 * static_cast<double>(i) / static_cast<double>(n);
+      const double y = 2.0 * static_cast<double>(j) / static_cast<double>(n);
+      mesh.vertices.push_back({x, y, 0.3 * std::sin(2.0 * x) * std::cos(3.0 * y) + 0.05 * unit(rng)});
+    }
+  const auto at = [n](std::size_t i, std::size_t j) { return static_cast<std::uint32_t>(j * (n + 1) + i); };
+  for (std::size_t j = 0; j < n; ++j)
+    for (std::size_t i = 0; i < n; ++i) {
+      if (unit(rng) < 0.5) {
+        mesh.triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+        mesh.triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+      } else {
+        mesh.triangles.push_back({at(i, j), at(i + 1, j), at(i, j + 1)});
+        mesh.triangles.push_back({at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)});
+      }
+    }
+  return mesh;
+}
+
+// The highest triangle over (x, y) by solving a + s (b - a) + t (c - a) = (x, y) in xy with
+// Cramer's rule (s, t >= 0, s + t <= 1, a hair of slack for points on an edge): -inf if none.
+double referenceMeshHeight(const Mesh& mesh, double x, double y) {
+  double best = -std::numeric_limits<double>::infinity();
+  for (const auto& tri : mesh.triangles) {
+    const Vec3 a = mesh.vertices[tri[0]], b = mesh.vertices[tri[1]], c = mesh.vertices[tri[2]];
+    const double e1x = b.x - a.x, e1y = b.y - a.y, e2x = c.x - a.x, e2y = c.y - a.y;
+    const double det = e1x * e2y - e1y * e2x;
+    if (det == 0.0) continue;
+    const double s = ((x - a.x) * e2y - (y - a.y) * e2x) / det;
+    const double t = (e1x * (y - a.y) - e1y * (x - a.x)) / det;
+    const double slack = 1e-12;
+    if (s < -slack || t < -slack || s + t > 1.0 + slack) continue;
+    best = std::max(best, a.z + s * (b.z - a.z) + t * (c.z - a.z));
+  }
+  return best;
+}
+
+TEST(CutSimulationMesh, DesignHeightsAreTheHighestTriangleAgainstAReference) {
+  std::mt19937_64 rng(7);
+  for (int trial = 0; trial < 6; ++trial) {
+    const Mesh mesh = heightFieldMesh(6 + 3 * static_cast<std::size_t>(trial), rng);
+    SimulationOptions options;
+    options.toolRadius = 0.25;
+    options.scallopHeight = 0.001;
+    options.resolution = 0.0173;
+    HeightGrid grid = simulationGrid(mesh, options);
+    std::vector<double> normalZ;
+    designHeights(mesh, grid, &normalZ);
+    std::size_t inside = 0;
+    for (std::size_t j = 0; j < grid.rows; ++j)
+      for (std::size_t i = 0; i < grid.columns; ++i) {
+        const Vec2 p = grid.point(i, j);
+        const double expected = referenceMeshHeight(mesh, p.x, p.y);
+        const double got = grid.z[j * grid.columns + i];
+        if (expected == -std::numeric_limits<double>::infinity()) {
+          // Off the footprint, or within a hair of its edge (the reference's slack).
+          if (got != expected) {
+            EXPECT_TRUE(p.x > -1e-9 && p.x < 2.0 + 1e-9 && p.y > -1e-9 && p.y < 2.0 + 1e-9);
+          }
+          continue;
+        }
+        ++inside;
+        ASSERT_NEAR(got, expected, 1e-12) << "trial " << trial << " at " << p.x << ", " << p.y;
+        EXPECT_GT(normalZ[j * grid.columns + i], 0.0);
+        EXPECT_LE(normalZ[j * grid.columns + i], 1.0);
+      }
+    EXPECT_GT(inside, 10000u);
+  }
+}
+
+// The same inclined plane as a bilinear patch and as two triangles, cut by the same lines:
+// the two simulations agree point by point (the design is the same plane), so the mesh path
+// inherits the surface path's closed-form check (ScallopOfAContourPlanOnAPlaneIsTheClosedForm).
+TEST(CutSimulationMesh, APlaneAsTrianglesIsCutAsThePlanePatchIs) {
+  BezierPatch patch;
+  patch.degreeU = patch.degreeV = 1;
+  patch.control = {{0.0, 0.0, 0.0}, {2.0, 0.0, 0.0}, {0.0, 2.0, 1.0}, {2.0, 2.0, 1.0}};
+  const Surface surface{Units::inch, {patch}};
+  Mesh mesh;
+  mesh.units = Units::inch;
+  mesh.vertices = {{0.0, 0.0, 0.0}, {2.0, 0.0, 0.0}, {0.0, 2.0, 1.0}, {2.0, 2.0, 1.0}};
+  mesh.triangles = {{0, 1, 3}, {0, 3, 2}};
+  const double radius = 0.25;
+  std::vector<SweptMove> moves;
+  for (int k = 0; k <= 20; ++k) {
+    const double y = 0.1 * k;
+    SweptMove move;
+    // Centres R along the plane's unit normal (0, -1/2, 1) / sqrt(1.25) from the line.
+    const Vec3 offset = radius / std::sqrt(1.25) * Vec3{0.0, -0.5, 1.0};
+    move.start = Vec3{0.0, y, 0.5 * y} + offset;
+    move.end = Vec3{2.0, y, 0.5 * y} + offset;
+    moves.push_back(move);
+  }
+  SimulationOptions options;
+  options.toolRadius = radius;
+  options.scallopHeight = 0.002;
+  options.classifyReach = false;
+  const SimulationReport onPatch = simulateCut(surface, moves, options);
+  const SimulationReport onMesh = simulateCut(mesh, moves, options);
+  ASSERT_EQ(onMesh.design.z.size(), onPatch.design.z.size());
+  double worst = 0.0;
+  for (std::size_t k = 0; k < onMesh.design.z.size(); ++k) {
+    if (onPatch.design.z[k] == -std::numeric_limits<double>::infinity()) continue;
+    if (onMesh.design.z[k] == -std::numeric_limits<double>::infinity()) continue;  // the edges' rounding
+    worst = std::max(worst, std::abs(onMesh.design.z[k] - onPatch.design.z[k]));
+    ASSERT_NEAR(onMesh.designNormalZ[k], onPatch.designNormalZ[k], 1e-12);
+  }
+  EXPECT_LE(worst, 1e-12);
+  EXPECT_NEAR(onMesh.maxScallop, onPatch.maxScallop, 1e-12);
+  EXPECT_NEAR(onMesh.maxGouge, onPatch.maxGouge, 1e-12);
+  EXPECT_EQ(onMesh.uncutPoints, onPatch.uncutPoints);
+  EXPECT_GT(onMesh.maxScallop, 0.0);
+  // No reach classification on meshes yet: nothing counted beyond reach.
+  EXPECT_EQ(onMesh.unreachablePoints, 0u);
+}
+
+TEST(CutSimulationMesh, BadInput) {
+  SimulationOptions options;
+  options.toolRadius = 0.25;
+  options.scallopHeight = 0.001;
+  EXPECT_THROW(simulateCut(Mesh{}, {}, options), Error);
+  GcodeProgram program;
+  program.units = Units::millimetre;
+  Mesh inches;
+  inches.units = Units::inch;
+  inches.vertices = {{0.0, 0.0, 0.0}, {1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}};
+  inches.triangles = {{0, 1, 2}};
+  EXPECT_THROW(verifyProgram(inches, program, options), Error);
+}
+
+}  // namespace
+}  // namespace scallop

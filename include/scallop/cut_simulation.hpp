@@ -87,6 +87,13 @@
 //         plan's own doing. Not a proof that no other centre comes nearer (a centre beside c
 //         may): a heuristic classification of what is left, in the report for what it is.
 //         Only points above H are classified, on every core, within maxReachChecks.
+// Meshes: a triangle mesh (mesh.hpp) may stand for the surface: the grid covers its
+//         vertices' xy box; the design at a grid point is the highest of the triangles over
+//         it, exactly (barycentric coordinates in the xy projection, each >= -1e-12 so that a
+//         point on an edge belongs to both triangles and to the footprint despite rounding;
+//         vertical triangles show only through their neighbours), |n_z| the winning
+//         triangle's; no reach classification yet (every point counts in the scallop
+//         figures). The sweep and the comparison are the same.
 // Cost:   O(P + sum over moves of the grid points within R of the move's box) time,
 //         O(P) memory, P the grid points; the design O(P) Newton solves of a few steps.
 // Errors: scallop::Error for invalid options (naming the option and value), non-finite
@@ -102,6 +109,7 @@
 #include "scallop/envelope.hpp"
 #include "scallop/gcode_reader.hpp"
 #include "scallop/gouge.hpp"
+#include "scallop/mesh.hpp"
 #include "scallop/surface.hpp"
 #include "scallop/toolpath.hpp"
 #include "scallop/vector.hpp"
@@ -226,6 +234,13 @@ struct SimulationReport {
 /// -infinity. Throws scallop::Error past the budget.
 HeightGrid simulationGrid(const Surface& surface, const SimulationOptions& options);
 
+/// The same over a mesh's vertices.
+HeightGrid simulationGrid(const Mesh& mesh, const SimulationOptions& options);
+
+/// The highest triangle of `mesh` over every point of `grid` (see the contract's Meshes);
+/// `normalZ`, if given, receives |n_z| of its unit normal (0 where there is none).
+void designHeights(const Mesh& mesh, HeightGrid& grid, std::vector<double>* normalZ = nullptr);
+
 /// The visible height of `surface` at every point of `grid` (see the contract); `normalZ`,
 /// if given, receives |n_z| of the unit normal there (0 off the surface).
 void designHeights(const Surface& surface, HeightGrid& grid, std::vector<double>* normalZ = nullptr);
@@ -253,9 +268,16 @@ ReachWitness reachWitness(const SurfaceDistance& distance, DropCutter& cutter, V
 SimulationReport simulateCut(const Surface& surface, const std::vector<SweptMove>& moves,
                              const SimulationOptions& options);
 
+/// The whole simulation on a mesh (see the contract's Meshes).
+SimulationReport simulateCut(const Mesh& mesh, const std::vector<SweptMove>& moves,
+                             const SimulationOptions& options);
+
 /// simulateCut on a program (its units must be the surface's).
 SimulationReport verifyProgram(const Surface& surface, const GcodeProgram& program,
                                const SimulationOptions& options);
+
+/// simulateCut on a program over a mesh (its units must be the mesh's).
+SimulationReport verifyProgram(const Mesh& mesh, const GcodeProgram& program, const SimulationOptions& options);
 
 /// simulateCut on a tool path (options.toolRadius 0 takes path.toolRadius).
 SimulationReport verifyToolPath(const Surface& surface, const ToolPath& path, SimulationOptions options);
