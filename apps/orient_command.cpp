@@ -61,14 +61,6 @@ std::string jsonDestination(const OrientOptions& options) {
   return options.svgDir.empty() ? std::string(kStandardStream) : std::string();
 }
 
-// A mesh by its name: .stl in any case.
-bool isStl(const std::string& path) {
-  if (path.size() < 4) return false;
-  std::string tail = path.substr(path.size() - 4);
-  for (char& c : tail) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return tail == ".stl";
-}
-
 // `orient` on an STL mesh (mesh_slicing.hpp): the largest empty cap of the +-facet normals.
 void runOrientMesh(const OrientOptions& options) {
   const std::string& path = options.surface.input;
@@ -79,19 +71,8 @@ void runOrientMesh(const OrientOptions& options) {
   reject(!options.tolerance.empty(), "--tolerance", "is the polygonal Gauss map's (a mesh's is exact)");
   reject(!options.svgDir.empty(), "--svg-dir", "draws a surface's Gauss map");
   reject(options.noCertify || options.latticeSeeds, "--no-certify/--lattice-seeds", "apply to Bezier surfaces");
-  StlOptions stl;
-  stl.units = options.units == "in" ? Units::inch : Units::millimetre;
-  stl.dropZeroArea = options.dropZeroArea;
   const auto start = std::chrono::steady_clock::now();
-  const StlMesh mesh = [&] {
-    try {
-      return readStl(path, stl);
-    } catch (const Error& e) {
-      if (!stl.dropZeroArea && std::string(e.what()).find("zero area") != std::string::npos)
-        throw Error(fmt::format("{}; --drop-zero-area skips such triangles", e.what()));
-      throw;
-    }
-  }();
+  const StlMesh mesh = loadStlMesh(path, options.units, options.dropZeroArea);
   const MeshSlicing result = optimalMeshSlicing(mesh.mesh);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const std::string jsonPath = jsonDestination(options);
@@ -181,7 +162,7 @@ void printSummary(const std::string& source, const OptimalSlicing& result, bool 
 
 void runOrient(const OrientOptions& options) {
   checkOptions(options);
-  if (isStl(options.surface.input)) {
+  if (isStlPath(options.surface.input)) {
     runOrientMesh(options);
     return;
   }
@@ -274,13 +255,7 @@ void addOrientCommand(CLI::App& app) {
   orient->add_flag("--lattice-seeds", options->latticeSeeds,
                    "also polish from the best directions of a fixed lattice of 2,000 (a "
                    "safety net beside the medial axis; off: the paper's method alone)");
-  orient
-      ->add_option("--units", options->units,
-                   "an STL mesh's units, in or mm (default mm: STL has none)")
-      ->check(CLI::IsMember({"in", "mm"}))
-      ->type_name("UNITS");
-  orient->add_flag("--drop-zero-area", options->dropZeroArea,
-                   "an STL mesh's triangles of zero area are dropped (counted) instead of refused");
+  addStlOptions(*orient, options->units, options->dropZeroArea);
   orient->callback([options] { runOrient(*options); });
 }
 

@@ -1,5 +1,6 @@
 #include "surface_options.hpp"
 
+#include <cctype>
 #include <cstddef>
 #include <cstdio>
 #include <map>
@@ -11,6 +12,7 @@
 
 #include "scallop/cad_import.hpp"
 #include "scallop/error.hpp"
+#include "scallop/mesh.hpp"
 #include "scallop/surface_io.hpp"
 
 namespace scallop::cli {
@@ -141,6 +143,34 @@ void addDialectOption(CLI::App& command, std::string& dialect) {
 
 GcodeDialect gcodeDialect(const std::string& name) {
   return name == "grbl" ? GcodeDialect::grbl : GcodeDialect::linuxcnc;
+}
+
+bool isStlPath(const std::string& path) {
+  if (path.size() < 4) return false;
+  std::string tail = path.substr(path.size() - 4);
+  for (char& c : tail) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return tail == ".stl";
+}
+
+StlMesh loadStlMesh(const std::string& path, const std::string& units, bool dropZeroArea) {
+  StlOptions stl;
+  stl.units = units == "in" ? Units::inch : Units::millimetre;
+  stl.dropZeroArea = dropZeroArea;
+  try {
+    return readStl(path, stl);
+  } catch (const Error& e) {
+    if (!dropZeroArea && std::string(e.what()).find("zero area") != std::string::npos)
+      throw Error(fmt::format("{}; --drop-zero-area skips such triangles", e.what()));
+    throw;
+  }
+}
+
+void addStlOptions(CLI::App& command, std::string& units, bool& dropZeroArea) {
+  command.add_option("--units", units, "an STL mesh's units, in or mm (default mm: STL has none)")
+      ->check(CLI::IsMember({"in", "mm"}))
+      ->type_name("UNITS");
+  command.add_flag("--drop-zero-area", dropZeroArea,
+                   "an STL mesh's triangles of zero area are dropped (counted) instead of refused");
 }
 
 }  // namespace scallop::cli

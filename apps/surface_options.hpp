@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include "scallop/gcode.hpp"
+#include "scallop/mesh.hpp"
 #include "scallop/surface.hpp"
 
 namespace scallop::cli {
@@ -48,6 +49,16 @@ Surface loadSurface(const SurfaceSource& source, bool announce = true);
 /// How messages and reports name the surface: "example NAME", "<stdin>" or the path, followed
 /// by " (patches LIST)" when some are selected.
 std::string sourceName(const SurfaceSource& source);
+
+/// A mesh by its name: .stl in any case.
+bool isStlPath(const std::string& path);
+
+/// The STL mesh at `path` in `units` ("in" or "mm"; empty: mm, STL has none); zero-area
+/// triangles refused (the message then names --drop-zero-area) unless `dropZeroArea`.
+StlMesh loadStlMesh(const std::string& path, const std::string& units, bool dropZeroArea);
+
+/// --units in|mm and --drop-zero-area, for commands that take an STL mesh.
+void addStlOptions(CLI::App& command, std::string& units, bool& dropZeroArea);
 
 /// --strategy contour|raster and --dialect linuxcnc|grbl, into `strategy` and `dialect`.
 void addStrategyOption(CLI::App& command, std::string& strategy);

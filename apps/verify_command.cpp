@@ -6,6 +6,7 @@
 
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,8 @@ struct VerifyOptions {
   std::string svgPath;
   bool failOnGouge = false;
   bool skipFaces = false;  // --skip-faces: a STEP or IGES file's unsupported faces
+  std::string units;          // --units in|mm: an STL mesh's (STL has none)
+  bool dropZeroArea = false;  // --drop-zero-area: an STL mesh's zero-area triangles
 };
 
 int runVerify(const VerifyOptions& options) {
@@ -58,8 +61,22 @@ int runVerify(const VerifyOptions& options) {
 
   SimulationOptions simulation;
   simulation.toolRadius = parsePositive(options.radius, "tool radius", "a positive length");
-  const Surface surface = loadSurface(source);
-  const bool inch = surface.units == Units::inch;
+  // The design: a triangle mesh (.stl) or a surface of Bezier patches.
+  const bool mesh = expected == 2 && isStlPath(source.input);
+  if (mesh && (!options.patches.empty() || options.skipFaces))
+    throw Error(fmt::format("{}: --patches and --skip-faces select a surface's patches or faces; not for a mesh",
+                            source.input));
+  if (!mesh && (!options.units.empty() || options.dropZeroArea))
+    throw Error("--units and --drop-zero-area are for STL meshes (a .stl file); a surface's units are in its file");
+  std::optional<StlMesh> stl;
+  std::optional<Surface> surface;
+  if (mesh) {
+    stl = loadStlMesh(source.input, options.units, options.dropZeroArea);
+  } else {
+    surface = loadSurface(source);
+  }
+  const Units designUnits = mesh ? stl->mesh.units : surface->units;
+  const bool inch = designUnits == Units::inch;
   simulation.scallopHeight = options.scallopHeight.empty()
                                  ? (inch ? 0.001 : 0.025)
                                  : parsePositive(options.scallopHeight, "scallop height", "a positive length");
@@ -76,7 +93,8 @@ int runVerify(const VerifyOptions& options) {
     simulation.stockAllowance = parseFinite(options.stockAllowance, "stock allowance", "a length >= 0");
 
   const GcodeProgram program = readGcodeProgram(programPath);
-  const SimulationReport report = verifyProgram(surface, program, simulation);
+  const SimulationReport report =
+      mesh ? verifyProgram(stl->mesh, program, simulation) : verifyProgram(*surface, program, simulation);
   const VerifySources sources{sourceName(source), program.sourceName == "-" ? "<stdin>" : program.sourceName,
                               program.unknownStartMoves, program.maxArcRadiusMismatch};
 
@@ -84,7 +102,7 @@ int runVerify(const VerifyOptions& options) {
   if (!options.jsonPath.empty()) outputs.push_back({options.jsonPath, verifyToJson(report, sources)});
   if (!options.svgPath.empty()) outputs.push_back({options.svgPath, verifySvg(report, sources)});
   writeOutputs(outputs, "");
-  const std::string units(unitsName(surface.units));
+  const std::string units(unitsName(designUnits));
   const bool gouges = report.maxGouge > report.gougeTolerance;
   if (options.jsonPath != kStandardStream) {
     fmt::print(stderr,
@@ -126,7 +144,7 @@ void addVerifyCommand(CLI::App& app, int& exitStatus) {
       "--fail-on-gouge when the deepest gouge exceeds the tolerance.\n"
       "Example: scallop plan --out out && scallop verify --example paper-1 out/toolpath.ngc --radius 0.25 "
       "--svg verify.svg");
-  verify->add_option("FILES", options->files, "[SURFACE] PROGRAM: the surface (JSON, .bpt, STEP or IGES; not with --example) and the G-code")
+  verify->add_option("FILES", options->files, "[SURFACE] PROGRAM: the surface (JSON, .bpt, STEP or IGES; .stl: a triangle mesh; not with --example) and the G-code")
       ->required()
       ->expected(1, 2)
       ->type_name("");
@@ -152,6 +170,7 @@ void addVerifyCommand(CLI::App& app, int& exitStatus) {
       ->type_name("Z");
   verify->add_option("--json", options->jsonPath, "write the figures as JSON (- = standard output)")->type_name("OUT");
   verify->add_option("--svg", options->svgPath, "write the heat map of scallops and gouges")->type_name("OUT");
+  addStlOptions(*verify, options->units, options->dropZeroArea);
   verify->add_flag("--fail-on-gouge", options->failOnGouge,
                    "exit with status 2 when the deepest gouge exceeds the tolerance (outputs are still written)");
   verify->callback([options, &exitStatus] { exitStatus = runVerify(*options); });

@@ -3,7 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <vector>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -77,6 +79,51 @@ TEST_F(VerifyCli, BadInputFailsWithOneLineAndNothingWritten) {
   const RunResult usage = run("verify --example paper-1 ok.ngc ok.ngc --radius 0.25 --json v.json");
   EXPECT_NE(usage.exitCode, 0);
   EXPECT_FALSE(fs::exists(workDir_ / "v.json"));
+}
+
+// A plane as a bilinear patch (JSON) and as two triangles (ASCII STL, written here): the same
+// program verified against either gives the same figures (the mesh's design is the same plane).
+TEST_F(VerifyCli, AnStlMeshIsVerifiedAsTheSurfaceItTriangulates) {
+  write("plane.json", R"({"units": "mm", "patches": [{"degree": [1, 1], "control_points": )"
+                      R"([[[0, 0, 0], [0, 20, 10]], [[20, 0, 0], [20, 20, 10]]]}]})");
+  write("plane.stl", "solid plane\n"
+                     "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 20 0 0\nvertex 20 20 10\nendloop\nendfacet\n"
+                     "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 20 20 10\nvertex 0 20 10\nendloop\nendfacet\n"
+                     "endsolid plane\n");
+  ASSERT_EQ(run("plan plane.json --tool-radius 3 --scallop-height 0.05 --out p --quiet").exitCode, 0);
+  const std::string common = " p/toolpath.ngc --radius 3 --scallop-height 0.05 --stock-allowance 0.5 --resolution 0.1";
+  const RunResult patch = run("verify plane.json" + common + " --json patch.json");
+  ASSERT_EQ(patch.exitCode, 0) << patch.err;
+  const RunResult mesh = run("verify plane.stl" + common + " --units mm --json mesh.json --svg mesh.svg");
+  ASSERT_EQ(mesh.exitCode, 0) << mesh.err;
+  const auto a = nlohmann::json::parse(readFile(workDir_ / "patch.json"));
+  const auto b = nlohmann::json::parse(readFile(workDir_ / "mesh.json"));
+  EXPECT_EQ(b["surface"], "plane.stl");
+  EXPECT_EQ(b["units"], "mm");
+  EXPECT_NEAR(b["scallop"]["max"].get<double>(), a["scallop"]["max"].get<double>(), 1e-9);
+  // The deepest vertical gouge is a ball beside the edge touching it at its equator (sqrt(2 R
+  // eps), the envelope's eps): it sits on the footprint's edge points, which the patch's Newton
+  // solve and the triangles' barycentric test each take within their own rounding. Both are
+  // under the tolerance.
+  EXPECT_LE(b["gouge"]["max"].get<double>(), 0.0025);
+  EXPECT_LE(a["gouge"]["max"].get<double>(), 0.0025);
+  EXPECT_GT(a["scallop"]["max"].get<double>(), 0.0);
+  EXPECT_LE(a["scallop"]["max"].get<double>(), 0.05);
+  EXPECT_NEAR(b["grid"]["surface_points"].get<double>(), a["grid"]["surface_points"].get<double>(), 500.0);
+  EXPECT_EQ(readFile(workDir_ / "mesh.svg").rfind("<svg", 0), 0u);
+  // Options that select a surface's patches are refused for a mesh, and mesh options for a
+  // surface; a broken mesh names the file; nothing written.
+  const auto refused = [&](const std::string& command, const std::vector<std::string>& parts) {
+    const RunResult result = run(command);
+    EXPECT_EQ(result.exitCode, 1) << command;
+    EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+    for (const std::string& part : parts) EXPECT_NE(result.err.find(part), std::string::npos) << result.err;
+    EXPECT_FALSE(fs::exists(workDir_ / "x.json")) << command;
+  };
+  refused("verify plane.stl" + common + " --patches 0 --json x.json", {"--patches", "mesh"});
+  refused("verify plane.json" + common + " --units mm --json x.json", {"--units", "STL"});
+  write("broken.stl", "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n");
+  refused("verify broken.stl" + common + " --json x.json", {"broken.stl"});
 }
 
 }  // namespace
