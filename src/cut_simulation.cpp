@@ -444,8 +444,20 @@ double sweptBallLowest(const SweptMove& move, double toolRadius, double x, doubl
 
 namespace {
 
-// The contract's grid over the xy box [xlo, xhi] x [ylo, yhi] (options validated).
-HeightGrid gridOver(double xlo, double xhi, double ylo, double yhi, const SimulationOptions& options) {
+// The xy box of some points.
+struct XyBox {
+  double xlo = kInf, xhi = -kInf, ylo = kInf, yhi = -kInf;
+  void add(const Vec3& p) {
+    xlo = std::min(xlo, p.x);
+    xhi = std::max(xhi, p.x);
+    ylo = std::min(ylo, p.y);
+    yhi = std::max(yhi, p.y);
+  }
+};
+
+// The contract's grid over the xy box (options validated).
+HeightGrid gridOver(const XyBox& box, const SimulationOptions& options) {
+  const auto [xlo, xhi, ylo, yhi] = box;
   const double radius = options.toolRadius, height = options.scallopHeight;
   const double spacing = options.resolution > 0.0 ? options.resolution
                                                   : height / (2.0 * flankSlope(radius, height));
@@ -473,29 +485,18 @@ HeightGrid gridOver(double xlo, double xhi, double ylo, double yhi, const Simula
 HeightGrid simulationGrid(const Surface& surface, const SimulationOptions& options) {
   validateOptions(options);
   if (surface.patches.empty()) throw Error("the surface has no patches");
-  double xlo = kInf, xhi = -kInf, ylo = kInf, yhi = -kInf;
-  for (const BezierPatch& patch : surface.patches) {
-    for (const Vec3& c : patch.control) {
-      xlo = std::min(xlo, c.x);
-      xhi = std::max(xhi, c.x);
-      ylo = std::min(ylo, c.y);
-      yhi = std::max(yhi, c.y);
-    }
-  }
-  return gridOver(xlo, xhi, ylo, yhi, options);
+  XyBox box;
+  for (const BezierPatch& patch : surface.patches)
+    for (const Vec3& c : patch.control) box.add(c);
+  return gridOver(box, options);
 }
 
 HeightGrid simulationGrid(const Mesh& mesh, const SimulationOptions& options) {
   validateOptions(options);
   if (mesh.triangles.empty()) throw Error("the mesh has no triangles");
-  double xlo = kInf, xhi = -kInf, ylo = kInf, yhi = -kInf;
-  for (const Vec3& v : mesh.vertices) {
-    xlo = std::min(xlo, v.x);
-    xhi = std::max(xhi, v.x);
-    ylo = std::min(ylo, v.y);
-    yhi = std::max(yhi, v.y);
-  }
-  return gridOver(xlo, xhi, ylo, yhi, options);
+  XyBox box;
+  for (const Vec3& v : mesh.vertices) box.add(v);
+  return gridOver(box, options);
 }
 
 void designHeights(const Surface& surface, HeightGrid& grid, std::vector<double>* normalZ) {
