@@ -10,6 +10,8 @@
 // Everything is computed first; the folder is written all or nothing.
 
 #include <algorithm>
+#include <chrono>
+#include <limits>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -30,6 +32,8 @@
 #include "scallop/gcode.hpp"
 #include "scallop/gcode_reader.hpp"
 #include "scallop/optimal_slicing.hpp"
+#include "scallop/mesh_raster.hpp"
+#include "scallop/mesh_drop.hpp"
 #include "scallop/orient_output.hpp"
 #include "scallop/paths_output.hpp"
 #include "scallop/rest_finishing.hpp"
@@ -46,7 +50,7 @@ namespace fs = std::filesystem;
 
 struct PlanOptions {
   SurfaceSource surface;
-  std::string strategy = "contour";
+  std::string strategy;  // empty: contour for a surface, raster for a mesh
   std::string toolRadius;
   std::string scallopHeight;
   std::string spacing;
@@ -59,6 +63,8 @@ struct PlanOptions {
   bool constantSpacing = false;
   bool noRestFinishing = false;
   bool quiet = false;
+  std::string units;          // --units in|mm: an STL mesh's
+  bool dropZeroArea = false;  // --drop-zero-area: an STL mesh's
 };
 
 // Rounds of rest finishing at most (each a simulation of the whole program more).
@@ -81,9 +87,158 @@ std::string restSummary(const PathsReport& report, Units units) {
                      length, unitsName(units), targets, first.maxScallopBefore);
 }
 
+// `plan` on an STL mesh: raster passes of exact drop lines (mesh_raster.hpp), every move proven
+// within eps; the program written and its cut simulated on the mesh itself.
+void runPlanMesh(const PlanOptions& options) {
+  const std::string& path = options.surface.input;
+  const auto reject = [&](bool given, const char* option, const char* why) {
+    if (given) throw Error(fmt::format("{}: {} {}; not for a mesh", path, option, why));
+  };
+  reject(!options.surface.patches.empty() || options.surface.skipFaces, "--patches/--skip-faces",
+         "select a surface's patches or faces");
+  reject(options.strategy == "contour", "--strategy contour",
+         "needs the surface's normal along its sections (a mesh's jumps at every edge): meshes are cut by raster");
+  reject(options.noDropEnvelope, "--no-drop-envelope", "keeps a surface strategy's own centres (a mesh's passes are drop lines)");
+  reject(options.constantSpacing, "--constant-spacing", "is the optimal planes' flat-surface spacing");
+  reject(options.noLinking || options.oneWay, "--no-linking/--one-way", "order a surface plan's passes (a mesh's raster is one zigzag)");
+  reject(options.noRestFinishing, "--no-rest-finishing", "switches off what a mesh plan does not do yet");
+  auto progress = [&](const std::string& line) {
+    if (!options.quiet) fmt::print(stderr, "scallop plan: {}...\n", line);
+  };
+  const auto start = std::chrono::steady_clock::now();
+  const StlMesh stl = loadStlMesh(path, options.units, options.dropZeroArea);
+  const Mesh& mesh = stl.mesh;
+  const bool inch = mesh.units == Units::inch;
+  const double radius = options.toolRadius.empty()
+                            ? (inch ? 0.25 : 6.0)
+                            : parsePositive(options.toolRadius, "tool radius", "a positive length");
+  std::optional<double> height;
+  double spacing = 0.0;
+  if (!options.spacing.empty()) {
+    spacing = parsePositive(options.spacing, "spacing", "a positive length");
+  } else {
+    height = options.scallopHeight.empty() ? (inch ? 0.001 : 0.025)
+                                           : parsePositive(options.scallopHeight, "scallop height", "a positive length");
+    if (!(*height < radius))
+      throw Error(fmt::format("the scallop height {} must be smaller than the tool radius {}", *height, radius));
+    spacing = meshRasterSpacing(radius, *height);
+  }
+  const double rapidRate = options.rapidRate.empty()
+                               ? defaultRapidRate(mesh.units)
+                               : parsePositive(options.rapidRate, "rapid rate", "a positive rate");
+  progress(fmt::format("{} triangles ({}); raster along x, lines at most {:.6g} {} apart, each the exact drop line "
+                       "of a {} {} ball",
+                       mesh.triangles.size(), stl.format == StlFormat::binary ? "binary" : "ASCII", spacing,
+                       unitsName(mesh.units), radius, unitsName(mesh.units)));
+  // The proofs see the mesh as the top of a solid (its open edges walled down to its bottom).
+  const Mesh solid = meshWithSkirt(mesh);
+  const MeshDropCutter cutter(solid, radius);
+  MeshRasterOptions raster;
+  raster.spacing = spacing;
+  // A chord of the drop line leaves at most its sag of material: a quarter of H, as the
+  // surfaces' sag rule (envelope.hpp).
+  if (height) raster.sagTolerance = *height / 4.0;
+  // With H, the steps between lines adapt to the facets' slopes (mesh_raster.hpp).
+  if (height) raster.scallopHeight = *height;
+  const MeshRasterPaths paths = [&] {
+    try {
+      return meshRasterPaths(cutter, solid, raster);
+    } catch (const Error& e) {
+      throw Error(fmt::format("{}: {}", path, e.what()));
+    }
+  }();
+  // The deepest the ball comes, exactly: every move's distance to the mesh.
+  double least = std::numeric_limits<double>::infinity();
+  Vec3 deepestAt;
+  for (const ToolPass& pass : paths.path.passes) {
+    Vec3 at = pass.start;
+    for (const ToolMove& move : pass.moves) {
+      const double d = cutter.segmentDistance(at, move.end, least);
+      if (d < least) {
+        least = d;
+        deepestAt = move.end;
+      }
+      at = move.end;
+    }
+  }
+
+  PathsReport report;
+  report.strategy = "raster";
+  report.source = path;
+  report.units = mesh.units;
+  report.toolRadius = radius;
+  report.spacing = spacing;
+  report.scallopHeight = height;
+  report.planeNormal = {0.0, 1.0, 0.0};
+  report.alphaRad = std::numbers::pi / 2.0;  // vertical planes: the flat-surface formula's sin(alpha) = 1
+  report.feedAngleRad = 0.0;
+  report.stats.planes = paths.lines;
+  report.stats.components = paths.lines;
+  report.stats.centreLength = paths.centreLength;
+  GougeReport gouge;
+  gouge.samples = 0;
+  gouge.signedMaxDepth = radius - least;
+  gouge.maxDepth = std::max(0.0, radius - least);
+  gouge.depthBound = gouge.maxDepth;  // exact distances, not samples
+  gouge.deepest.center = deepestAt;
+  report.gouge = gouge;
+
+  progress("writing the G-code");
+  const GcodeDialect dialect = gcodeDialect(options.dialect);
+  const std::string title = fmt::format("scallop plan raster {}", path);
+  const std::string programName = dialect == GcodeDialect::grbl ? "toolpath.gcode" : "toolpath.ngc";
+  double top = -std::numeric_limits<double>::infinity();
+  for (const Vec3& v : mesh.vertices) top = std::max(top, v.z);
+  const GcodeOptions gcodeOptions = defaultGcodeOptions(mesh.units, top, paths.path, dialect, title);
+  const std::string program = gcodeProgram(paths.path, gcodeOptions);
+  report.motion = gcodeMotion(paths.path, gcodeOptions, rapidRate);
+  report.feedRate = gcodeOptions.feedRate;
+  report.plungeFeedRate = gcodeOptions.plungeFeedRate;
+  report.rapidRate = rapidRate;
+  progress("simulating the cut of the program on the mesh (scallop verify)");
+  SimulationOptions simulation;
+  simulation.toolRadius = radius;
+  simulation.scallopHeight = height ? *height : radius - std::sqrt(radius * radius - 0.25 * spacing * spacing);
+  simulation.stockAllowance = std::max(inch ? 0.01 : 0.25, 2.0 * simulation.scallopHeight);
+  const SimulationReport simulated = verifyProgram(mesh, parseGcodeProgram(program, programName), simulation);
+  report.verification = VerificationSummary{simulated.design.spacing, simulated.heightErrorBound,
+                                            *simulation.stockAllowance, simulated.maxGouge,
+                                            simulated.maxGougeAt, simulated.gougeArea,
+                                            simulated.gougeTolerance, simulated.maxScallop,
+                                            simulated.maxScallopAt, simulated.scallopP99,
+                                            simulated.meanScallop, simulated.uncutArea,
+                                            simulated.unreachableArea, simulated.maxUnreachableScallop,
+                                            simulated.rapidsCutting, simulated.seconds};
+  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  progress("writing the report");
+  const fs::path dir = options.out;
+  writeOutputs({{(dir / programName).string(), program},
+                {(dir / "report.json").string(), pathsToJson(report, paths.path)},
+                {(dir / "verify.svg").string(), verifySvg(simulated, {path, programName, 0, 0.0})}},
+               options.out);
+  const std::string units(unitsName(mesh.units));
+  fmt::print(stderr,
+             "scallop plan: raster on {}: {} triangles, {} lines {:.5g} to {:.5g} {} apart, tool-centre length {:.4f} {}, "
+             "{} moves proven within eps {:.2g} ({} unproven), deepest ball interference {:.6f} {} (exact); {}; "
+             "simulated: gouge {:.6f}, scallop max {:.6f} / 99% {:.6f} {}{}; {:.2f} s -> {}/\n",
+             path, mesh.triangles.size(), paths.lines, paths.minSpacing, spacing, units, paths.centreLength, units,
+             paths.path.passes.empty() ? 0 : paths.path.passes[0].moves.size(), paths.eps, paths.unprovenMoves,
+             gouge.maxDepth, units, cycleSummary(report, mesh.units), simulated.maxGouge, simulated.maxScallop,
+             simulated.scallopP99, units,
+             height && simulated.maxScallop > *height
+                 ? fmt::format(" (above H = {} on {:.4g} {}^2: the facets' cusps are modelled, not the edges between them "
+                               "nor what a ball cannot reach)",
+                               *height, simulated.uncutArea, units)
+                 : std::string(),
+             report.seconds, options.out);
+}
+
 void runPlan(const PlanOptions& options) {
   if (!options.spacing.empty() && !options.scallopHeight.empty())
     throw CLI::ValidationError("plan", "give at most one of --spacing and --scallop-height");
+  if (isStlPath(options.surface.input)) return runPlanMesh(options);
+  if (!options.units.empty() || options.dropZeroArea)
+    throw Error("--units and --drop-zero-area are for STL meshes (a .stl file); a surface's units are in its file");
   SurfaceSource from = options.surface;
   if (from.input.empty() && from.example.empty()) from.example = "paper-1";  // the main job
   const Surface surface = loadSurface(from, !options.quiet);
@@ -94,7 +249,7 @@ void runPlan(const PlanOptions& options) {
   };
 
   JobOptions job;
-  job.strategy = options.strategy;
+  job.strategy = options.strategy.empty() ? "contour" : options.strategy;
   // Defaults: a 1/2 inch (12 mm) ball-end mill and a finishing scallop of 0.001 in (0.025 mm).
   job.toolRadius = options.toolRadius.empty()
                        ? (inch ? 0.25 : 6.0)
@@ -122,7 +277,7 @@ void runPlan(const PlanOptions& options) {
                                           orientation.gaussMap.boundarySegments, orientation.seconds};
 
   const GcodeDialect dialect = gcodeDialect(options.dialect);
-  const std::string title = fmt::format("scallop plan {} {}", options.strategy, source);
+  const std::string title = fmt::format("scallop plan {} {}", job.strategy, source);
   const std::string programName = dialect == GcodeDialect::grbl ? "toolpath.gcode" : "toolpath.ngc";
   // The program as written, read back and cut in simulation (scallop verify): the finishing
   // stock is the surface raised by half the links' clearance (what they assume roughing
@@ -173,7 +328,7 @@ void runPlan(const PlanOptions& options) {
   progress("writing the report and figures");
   const fs::path dir = options.out;
   const std::string figureTitle = fmt::format(
-      "scallop plan: {} strategy on {}, R = {} {}, spacing {:.5g}, {} passes", options.strategy,
+      "scallop plan: {} strategy on {}, R = {} {}, spacing {:.5g}, {} passes", job.strategy,
       source, job.toolRadius, unitsName(surface.units), report.spacing, result.path.passes.size());
   report.motion = gcodeMotion(result.path, gcodeOptions, rapidRate);
   report.feedRate = gcodeOptions.feedRate;
@@ -210,7 +365,7 @@ void runPlan(const PlanOptions& options) {
              "scallop plan: {} on {}: N* = ({:.4f}, {:.4f}, {:.4f}), alpha* = {:.3f} deg; spacing "
              "{:.5g}, {} planes, {} components, tool-centre length {:.4f} {}{}; {}; {:.2f} s -> "
              "{}/\n",
-             options.strategy, source, orientation.normal.x, orientation.normal.y,
+             job.strategy, source, orientation.normal.x, orientation.normal.y,
              orientation.normal.z, orientation.alphaRad * 180.0 / std::numbers::pi, report.spacing,
              s.planes, s.components, s.centreLength, unitsName(surface.units), gouge,
              cycleSummary(report, surface.units) +
@@ -261,6 +416,7 @@ void addPlanCommand(CLI::App& app) {
                  "no rest passes where the simulated cut leaves more than H on points the ball can "
                  "reach (by default, with a scallop height and adaptive spacing, up to two rounds of "
                  "them, each simulated again)");
+  addStlOptions(*plan, options->units, options->dropZeroArea);
   plan->add_option("--out", options->out, "output folder (default scallop-out)")->type_name("DIR");
   plan->add_flag("--quiet", options->quiet, "no progress lines");
   plan->callback([options] { runPlan(*options); });

@@ -301,7 +301,16 @@ void addPasses(const Surface& surface, const std::string& source, const JobOptio
 
 GcodeOptions defaultGcodeOptions(const Surface& surface, const ToolPath& path,
                                  GcodeDialect dialect, const std::string& title) {
-  const bool inch = surface.units == Units::inch;
+  // The surface's control points bound it from above, so rapids at the safe height clear it.
+  double top = -std::numeric_limits<double>::infinity();
+  for (const BezierPatch& patch : surface.patches)
+    for (const Vec3& p : patch.control) top = std::max(top, p.z);
+  return defaultGcodeOptions(surface.units, top, path, dialect, title);
+}
+
+GcodeOptions defaultGcodeOptions(Units units, double partTop, const ToolPath& path, GcodeDialect dialect,
+                                 const std::string& title) {
+  const bool inch = units == Units::inch;
   GcodeOptions options;
   options.dialect = dialect;
   options.feedRate = inch ? 40.0 : 1000.0;
@@ -309,11 +318,8 @@ GcodeOptions defaultGcodeOptions(const Surface& surface, const ToolPath& path,
   options.spindleRpm = 10000.0;
   options.title = title;
   // The highest tip (centre - R) of the path: line ends, and the top of every arc, which
-  // lies at most its radius above its centre. The surface's control points bound the
-  // surface from above, so rapids at the safe height clear it too.
-  double top = -std::numeric_limits<double>::infinity();
-  for (const BezierPatch& patch : surface.patches)
-    for (const Vec3& p : patch.control) top = std::max(top, p.z);
+  // lies at most its radius above its centre; and the part's top.
+  double top = partTop;
   for (const ToolPass& pass : path.passes) {
     top = std::max(top, pass.start.z - path.toolRadius);
     for (const ToolMove& move : pass.moves) {

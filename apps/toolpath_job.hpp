@@ -61,6 +61,9 @@ void addPasses(const Surface& surface, const std::string& source, const JobOptio
 /// control points and of the path's tool tips.
 GcodeOptions defaultGcodeOptions(const Surface& surface, const ToolPath& path,
                                  GcodeDialect dialect, const std::string& title);
+/// The same for a part whose highest point is `partTop` (a mesh's highest vertex).
+GcodeOptions defaultGcodeOptions(Units units, double partTop, const ToolPath& path, GcodeDialect dialect,
+                                 const std::string& title);
 
 /// The rapid rate assumed for the cycle time when none is given: 200 in/min or 5000 mm/min.
 double defaultRapidRate(Units units);

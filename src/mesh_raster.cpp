@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <map>
+#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
@@ -11,11 +14,140 @@
 
 namespace scallop {
 
+Mesh meshWithSkirt(const Mesh& mesh) {
+  Mesh out = mesh;
+  if (mesh.vertices.empty()) return out;
+  double bottom = std::numeric_limits<double>::infinity();
+  for (const Vec3& v : mesh.vertices) bottom = std::min(bottom, v.z);
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> uses;
+  for (const auto& t : mesh.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t u = t[static_cast<std::size_t>(k)], v = t[static_cast<std::size_t>((k + 1) % 3)];
+      ++uses[{std::min(u, v), std::max(u, v)}];
+    }
+  std::map<std::uint32_t, std::uint32_t> below;  // a vertex's foot at the bottom
+  const auto foot = [&](std::uint32_t v) {
+    const auto [at, fresh] = below.try_emplace(v, static_cast<std::uint32_t>(out.vertices.size()));
+    if (fresh) out.vertices.push_back({mesh.vertices[v].x, mesh.vertices[v].y, bottom});
+    return at->second;
+  };
+  for (const auto& [edge, count] : uses) {
+    if (count != 1) continue;
+    const auto [a, b] = edge;
+    if (mesh.vertices[a].z <= bottom && mesh.vertices[b].z <= bottom) continue;  // on the bottom: no wall
+    const std::uint32_t fa = foot(a), fb = foot(b);
+    out.triangles.push_back({a, b, fb});
+    out.triangles.push_back({a, fb, fa});
+  }
+  return out;
+}
+
 double meshRasterSpacing(double toolRadius, double scallopHeight) {
   if (!(toolRadius > 0.0) || !std::isfinite(toolRadius) || !(scallopHeight > 0.0) || !(scallopHeight < toolRadius))
     throw Error(fmt::format("raster spacing: need 0 < H < R, got H = {} and R = {}", scallopHeight, toolRadius));
   return 2.0 * std::sqrt(2.0 * toolRadius * scallopHeight - scallopHeight * scallopHeight);
 }
+
+namespace {
+
+// The cusp-adaptive line offsets of the contract: facets as intervals of the touching centres'
+// across-coordinate with the step each allows, in buckets of the constant spacing's width.
+std::vector<double> adaptiveOffsets(const Mesh& mesh, double radius, Vec2 along, Vec2 across, double b0, double b1,
+                                    const MeshRasterOptions& options, std::size_t& floorSteps) {
+  const double height = options.scallopHeight;
+  if (!(height < radius))
+    throw Error(fmt::format("mesh raster: the scallop height {} must be smaller than the tool radius {}", height, radius));
+  const double widest = 2.0 * std::sqrt(2.0 * radius * height - height * height);  // w_H
+  const double most = options.spacing, least = options.spacing / 32.0;
+  struct Band {
+    double lo, hi, step;
+  };
+  // Unit upward normals and centroids, and each edge's facets, for the concave bend.
+  const std::size_t facets = mesh.triangles.size();
+  std::vector<Vec3> normals(facets), centroids(facets);
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<std::size_t>> edgeFacets;
+  for (std::size_t f = 0; f < facets; ++f) {
+    const auto& t = mesh.triangles[f];
+    const Vec3 a = mesh.vertices[t[0]], b = mesh.vertices[t[1]], c = mesh.vertices[t[2]];
+    Vec3 n = cross(b - a, c - a);
+    const double length = norm(n);
+    normals[f] = length > 0.0 ? (n.z < 0.0 ? -1.0 : 1.0) / length * n : Vec3{};
+    centroids[f] = (1.0 / 3.0) * (a + b + c);
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t u = t[static_cast<std::size_t>(k)], v = t[static_cast<std::size_t>((k + 1) % 3)];
+      edgeFacets[{std::min(u, v), std::max(u, v)}].push_back(f);
+    }
+  }
+  // The largest concave bend at each facet: across an edge to a neighbour whose far vertex
+  // stands above the facet's plane, the angle between their normals over their centroids'
+  // distance (a curvature estimate, in any direction: conservative across the feed).
+  std::vector<double> concave(facets, 0.0);
+  for (const auto& [edge, list] : edgeFacets) {
+    for (const std::size_t f : list) {
+      for (const std::size_t g : list) {
+        if (f == g || normals[f].z <= 0.0 || normals[g].z <= 0.0) continue;
+        const auto& t = mesh.triangles[g];
+        Vec3 far = mesh.vertices[t[0]];
+        for (const std::uint32_t w : t)
+          if (w != edge.first && w != edge.second) far = mesh.vertices[w];
+        if (dot(far - mesh.vertices[edge.first], normals[f]) <= 0.0) continue;  // convex or flat
+        const double distance = norm(centroids[g] - centroids[f]);
+        const double angle = std::acos(std::clamp(dot(normals[f], normals[g]), -1.0, 1.0));
+        if (distance > 0.0) concave[f] = std::max(concave[f], angle / distance);
+      }
+    }
+  }
+  std::vector<Band> bands;
+  for (std::size_t f = 0; f < facets; ++f) {
+    const Vec3 n = normals[f];
+    if (!(n.z > 0.0)) continue;  // vertical or degenerate: touches through its edges only
+    const auto& t = mesh.triangles[f];
+    const Vec3 a = mesh.vertices[t[0]], b = mesh.vertices[t[1]], c = mesh.vertices[t[2]];
+    const double nh = n.x * along.x + n.y * along.y, ne = n.x * across.x + n.y * across.y;
+    const double sh = -nh / n.z, se = -ne / n.z;
+    // On a surface bending concavely with curvature k (radius 1 / k > R) balls whose
+    // centres are w apart leave w^2 / (8 R (1 - R k)): the step shrinks by sqrt(1 - R k),
+    // held at 1/4 where the bend is tighter (a crease the ball cannot enter).
+    const double bend = std::max(0.25, std::sqrt(std::max(0.0, 1.0 - radius * concave[f])));
+    const double step = bend * widest * std::sqrt(1.0 + sh * sh) / std::sqrt(1.0 + se * se + sh * sh);
+    if (step >= most) continue;  // allows the constant spacing: no constraint
+    const auto e = [&](Vec3 p) { return p.x * across.x + p.y * across.y + radius * ne; };
+    bands.push_back({std::min({e(a), e(b), e(c)}), std::max({e(a), e(b), e(c)}), step});
+  }
+  // Buckets of width `most` over [b0 - R, b1 + R]: a window [b, b + most] meets at most two.
+  const double origin = b0 - radius;
+  const auto bucketOf = [&](double x) {
+    return static_cast<std::size_t>(std::max(0.0, std::floor((x - origin) / most)));
+  };
+  const std::size_t count = bucketOf(b1 + radius) + 2;
+  if (!(static_cast<double>(count) <= 4.0 * static_cast<double>(options.maxLines)))
+    throw Error(fmt::format("mesh raster: a spacing of {} across {} exceeds the budget of {} lines", most, b1 - b0,
+                            options.maxLines));
+  std::vector<std::vector<std::size_t>> buckets(count);
+  for (std::size_t k = 0; k < bands.size(); ++k)
+    for (std::size_t i = bucketOf(bands[k].lo); i <= std::min(count - 1, bucketOf(bands[k].hi)); ++i) buckets[i].push_back(k);
+  std::vector<double> offsets{b0};
+  floorSteps = 0;
+  for (double at = b0; at < b1;) {
+    double step = most;
+    for (std::size_t i = bucketOf(at); i <= std::min(count - 1, bucketOf(at + most)); ++i)
+      for (const std::size_t k : buckets[i])
+        if (bands[k].hi >= at && bands[k].lo <= at + most) step = std::min(step, bands[k].step);
+    if (step < least) {
+      step = least;
+      ++floorSteps;
+    }
+    at = at + step >= b1 ? b1 : at + step;
+    offsets.push_back(at);
+    if (offsets.size() > options.maxLines)
+      throw Error(fmt::format("mesh raster: the scallop height {} needs more than {} lines across {}", height,
+                              options.maxLines, b1 - b0));
+  }
+  if (offsets.size() > 1 && offsets[offsets.size() - 2] == b1) offsets.pop_back();
+  return offsets;
+}
+
+}  // namespace
 
 MeshRasterPaths meshRasterPaths(const MeshDropCutter& cutter, const Mesh& mesh, const MeshRasterOptions& options) {
   if (!(options.spacing > 0.0) || !std::isfinite(options.spacing))
@@ -34,21 +166,32 @@ MeshRasterPaths meshRasterPaths(const MeshDropCutter& cutter, const Mesh& mesh, 
     b0 = std::min(b0, b);
     b1 = std::max(b1, b);
   }
-  const double t0 = a0 - radius, t1 = a1 + radius;
-  const double steps = std::ceil((b1 - b0) / options.spacing);
-  if (!(steps + 1.0 <= static_cast<double>(options.maxLines)))
-    throw Error(fmt::format("mesh raster: a spacing of {} needs {:.0f} lines across {}, more than the budget of {}",
-                            options.spacing, steps + 1.0, b1 - b0, options.maxLines));
-  const auto lines = static_cast<std::size_t>(steps) + 1;
-  const auto offset = [&](std::size_t k) {
-    return k + 1 == lines ? b1 : b0 + static_cast<double>(k) * options.spacing;
-  };
-
+  // The lines run from R + R/64 before the mesh to as far beyond: their ends and the links
+  // between them touch nothing (a ball exactly R beside the mesh's extreme vertex would graze
+  // the vertical line through it at its equator, below the part's edge: no cut, but a z-map
+  // reads one there).
+  const double margin = radius / 64.0;
+  const double t0 = a0 - radius - margin, t1 = a1 + radius + margin;
+  if (!(options.scallopHeight >= 0.0) || !std::isfinite(options.scallopHeight))
+    throw Error(fmt::format("mesh raster: the scallop height must be >= 0 and finite, got {}", options.scallopHeight));
+  MeshRasterPaths out;
+  const std::vector<double> offsets = [&] {
+    // Beyond the extreme lines by R: a point near the mesh's extreme whose surface slopes
+    // towards it is finished by a ball beyond it (at q + R n).
+    const double lo = b0 - radius + margin, hi = b1 + radius - margin;
+    if (options.scallopHeight > 0.0) return adaptiveOffsets(mesh, radius, along, across, lo, hi, options, out.floorSteps);
+    const double steps = std::ceil((hi - lo) / options.spacing);
+    if (!(steps + 1.0 <= static_cast<double>(options.maxLines)))
+      throw Error(fmt::format("mesh raster: a spacing of {} needs {:.0f} lines across {}, more than the budget of {}",
+                              options.spacing, steps + 1.0, hi - lo, options.maxLines));
+    std::vector<double> b;
+    for (std::size_t k = 0; k < static_cast<std::size_t>(steps); ++k) b.push_back(lo + static_cast<double>(k) * options.spacing);
+    b.push_back(hi);
+    return b;
+  }();
   DropLineOptions drop;
   drop.eps = options.eps;
   drop.sagTolerance = options.sagTolerance;
-  MeshRasterPaths out;
-  out.lines = lines;
   out.path.units = mesh.units;
   out.path.toolRadius = radius;
   ToolPass pass;
@@ -70,20 +213,37 @@ MeshRasterPaths meshRasterPaths(const MeshDropCutter& cutter, const Mesh& mesh, 
       }
     }
   };
+  // Every line's drop line; those that touch nothing (beyond the mesh by R) are left out.
+  std::vector<DropLine> dropLines;
+  std::vector<double> kept;
+  for (const double b : offsets) {
+    DropLine line = cutter.dropLine(Vec2{b * across.x, b * across.y}, along, t0, t1, drop);
+    const bool touches = std::any_of(line.vertices.begin(), line.vertices.end(), [](const DropLineVertex& v) {
+      return v.contact.feature != MeshFeature::none;
+    });
+    out.drops += line.drops;
+    out.proofs += line.proofs;
+    if (!touches) continue;
+    dropLines.push_back(std::move(line));
+    kept.push_back(b);
+  }
+  const std::size_t lines = kept.size();
+  out.lines = lines;
+  out.lineOffsets = kept;
+  out.minSpacing = lines > 2 ? std::numeric_limits<double>::infinity() : (lines == 2 ? kept[1] - kept[0] : 0.0);
+  for (std::size_t k = 0; k + 2 < lines; ++k) out.minSpacing = std::min(out.minSpacing, kept[k + 1] - kept[k]);
   for (std::size_t k = 0; k < lines; ++k) {
-    const double b = offset(k);
     const bool backwards = k % 2 == 1;
     if (k > 0) {
       // The link across, at the end both lines share: from b_k-1 to b_k along e. Its first
       // vertex is the previous line's last (the same drop point), its last this line's first.
       const double t = backwards ? t1 : t0;
-      const DropLine link =
-          cutter.dropLine(Vec2{t * along.x, t * along.y}, across, offset(k - 1), b, drop);
-      DropLine inner = link;
-      if (!inner.vertices.empty()) inner.vertices.pop_back();
-      append(inner, false, true);
+      DropLine link = cutter.dropLine(Vec2{t * along.x, t * along.y}, across, kept[k - 1], kept[k], drop);
+      if (!link.vertices.empty()) link.vertices.pop_back();
+      append(link, false, true);
     }
-    const DropLine line = cutter.dropLine(Vec2{b * across.x, b * across.y}, along, t0, t1, drop);
+    DropLine& line = dropLines[k];
+    line.drops = line.proofs = 0;  // counted above
     append(line, backwards, false);
   }
   Vec3 at = pass.start;

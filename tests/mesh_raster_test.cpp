@@ -145,6 +145,77 @@ TEST(MeshRaster, AnInclinedPlaneLeavesTheClosedFormCusp) {
   EXPECT_GT(cusp, height);  // the slope widens the cusp: the plan measures it, never promises H
 }
 
+// The same plane with the cusp-adaptive steps for H: w = Delta sqrt(1 + s_e^2) = w_H on it,
+// so the simulated cusp is H (within the grid's bound), never above.
+TEST(MeshRaster, AdaptiveStepsHoldTheCuspOnASlopeToH) {
+  Mesh mesh;
+  mesh.units = Units::inch;
+  mesh.vertices = {{0.0, 0.0, 0.0}, {2.0, 0.0, 0.0}, {0.0, 2.0, 1.0}, {2.0, 2.0, 1.0}};
+  mesh.triangles = {{0, 1, 3}, {0, 3, 2}};
+  const double radius = 0.25, height = 0.002;
+  const MeshDropCutter cutter(mesh, radius);
+  MeshRasterOptions options;
+  options.spacing = meshRasterSpacing(radius, height);
+  options.scallopHeight = height;
+  const MeshRasterPaths paths = meshRasterPaths(cutter, mesh, options);
+  EXPECT_NEAR(paths.minSpacing, options.spacing / std::sqrt(1.25), 1e-12);
+  EXPECT_EQ(paths.floorSteps, 0u);
+  SimulationOptions simulation;
+  simulation.toolRadius = radius;
+  simulation.scallopHeight = height;
+  simulation.stockAllowance = 0.02;
+  const SimulationReport report = simulateCut(mesh, sweptMoves(paths.path), simulation);
+  const double cosPhi = 1.0 / std::sqrt(1.25);
+  double inner = 0.0;
+  for (std::size_t j = 0; j < report.stock.rows; ++j)
+    for (std::size_t i = 0; i < report.stock.columns; ++i) {
+      const Vec2 p = report.stock.point(i, j);
+      if (p.x < 0.3 || p.x > 1.7 || p.y < 0.3 || p.y > 1.7) continue;
+      const std::size_t k = j * report.stock.columns + i;
+      inner = std::max(inner, (report.stock.z[k] - report.design.z[k]) * report.designNormalZ[k]);
+    }
+  std::printf("[          ] %zu lines, step %.6f (flat %.6f), simulated cusp %.6f (H %.6f)\n", paths.lines,
+              paths.minSpacing, options.spacing, inner, height);
+  EXPECT_LE(inner, height + 1e-9);
+  EXPECT_GE(inner, height - report.heightErrorBound / cosPhi);
+  // A horizontal plane keeps the flat spacing.
+  Mesh flat = mesh;
+  for (Vec3& v : flat.vertices) v.z = 0.0;
+  const MeshDropCutter flatCutter(flat, radius);
+  EXPECT_NEAR(meshRasterPaths(flatCutter, flat, options).minSpacing, options.spacing, 1e-12);
+}
+
+// A square sheet tilted up along y: its three raised open edges get walls down to its lowest
+// z (two triangles each; the edge lying on the bottom none); a ball beside the high edge and
+// below it is clear of the sheet but not of the solid's side.
+TEST(MeshRaster, TheSkirtWallsTheOpenEdgesOfASheet) {
+  Mesh sheet;
+  sheet.vertices = {{0.0, 0.0, 0.0}, {1.0, 0.0, 0.0}, {0.0, 1.0, 1.0}, {1.0, 1.0, 1.0}};
+  sheet.triangles = {{0, 1, 3}, {0, 3, 2}};
+  const Mesh solid = meshWithSkirt(sheet);
+  EXPECT_EQ(solid.triangles.size(), 2u + 3u * 2u);
+  for (std::size_t t = 2; t < solid.triangles.size(); ++t) {
+    const auto& tri = solid.triangles[t];
+    const Vec3 n = cross(solid.vertices[tri[1]] - solid.vertices[tri[0]], solid.vertices[tri[2]] - solid.vertices[tri[0]]);
+    EXPECT_EQ(n.z, 0.0) << t;  // vertical
+  }
+  const double radius = 0.25;
+  const Vec3 a{0.5, 1.2, 0.5}, b{0.6, 1.2, 0.5};  // 0.2 beside the edge y = 1 (at z = 1), half way down
+  EXPECT_TRUE(MeshDropCutter(sheet, radius).segmentClear(a, b, radius - 1e-6));
+  EXPECT_FALSE(MeshDropCutter(solid, radius).segmentClear(a, b, radius - 1e-6));
+  // The drop heights are the same: a wall touches the ball only through its top edge.
+  const MeshDropCutter open(sheet, radius), closed(solid, radius);
+  for (double x = -0.3; x <= 1.3; x += 0.1)
+    for (double y = -0.3; y <= 1.3; y += 0.1) {
+      const double za = open.drop(x, y).z, zb = closed.drop(x, y).z;
+      if (za == -std::numeric_limits<double>::infinity()) {
+        EXPECT_LE(zb, radius) << x << ", " << y;  // the walls' bottom edges at z = 0
+        continue;
+      }
+      EXPECT_NEAR(std::max(za, radius), std::max(zb, radius), 1e-12) << x << ", " << y;
+    }
+}
+
 TEST(MeshRaster, RejectsBadOptions) {
   Mesh mesh;
   mesh.vertices = {{0.0, 0.0, 0.0}, {1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}};
@@ -158,6 +229,11 @@ TEST(MeshRaster, RejectsBadOptions) {
   options.angleRad = 0.0;
   options.spacing = 1e-9;
   EXPECT_THROW(meshRasterPaths(cutter, mesh, options), Error);  // over the line budget
+  options.spacing = 0.01;
+  options.scallopHeight = 0.5;  // not below R
+  EXPECT_THROW(meshRasterPaths(cutter, mesh, options), Error);
+  options.scallopHeight = -1.0;
+  EXPECT_THROW(meshRasterPaths(cutter, mesh, options), Error);
   EXPECT_THROW(meshRasterSpacing(0.1, 0.2), Error);
   EXPECT_THROW(meshRasterSpacing(0.1, 0.0), Error);
   EXPECT_NEAR(meshRasterSpacing(0.25, 0.001), 2.0 * std::sqrt(2.0 * 0.25 * 0.001 - 1e-6), 1e-15);

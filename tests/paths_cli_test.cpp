@@ -11,10 +11,13 @@
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "cli_fixture.hpp"
 #include "rs274.hpp"
+#include "scallop/bezier.hpp"
+#include "scallop/surface.hpp"
 
 namespace {
 
@@ -160,6 +163,60 @@ TEST_F(PathsCli, PlanRasterReportsTheGougeCheck) {
   EXPECT_GT(report["stats"]["link_length"].get<double>(), 0.0);
   EXPECT_TRUE(fs::exists(workDir_ / "r" / "toolpath.gcode"));
   expectPlainNumbers(readFile(workDir_ / "r" / "toolpath.gcode"));
+}
+
+// paper-1 sampled on a 48 x 48 grid of its parameters and written as an ASCII STL in inches:
+// `plan` cuts it by raster (the default for a mesh), every move proven clear (the exact
+// deepest interference at most eps), the program accepted by LinuxCNC's rs274, and the
+// simulated cut on the mesh finds no gouge beyond its tolerance and scallops within H where the
+// mesh is not steep across the feed. Options meant for surfaces are refused by name.
+TEST_F(PathsCli, PlanCutsAnStlMeshByRaster) {
+  const scallop::Surface surface = scallop::exampleSurface("paper-1");
+  std::string stl = "solid paper1\n";
+  const int n = 48;
+  const auto at = [&](int i, int j) { return scallop::point(surface.patches[0], i / double(n), j / double(n)); };
+  const auto facet = [&](scallop::Vec3 a, scallop::Vec3 b, scallop::Vec3 c) {
+    stl += fmt::format("facet normal 0 0 0\nouter loop\nvertex {} {} {}\nvertex {} {} {}\nvertex {} {} {}\nendloop\nendfacet\n",
+                       a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z);
+  };
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      facet(at(i, j), at(i + 1, j), at(i + 1, j + 1));
+      facet(at(i, j), at(i + 1, j + 1), at(i, j + 1));
+    }
+  stl += "endsolid paper1\n";
+  write("paper1.stl", stl);
+  const RunResult result = run("plan paper1.stl --units in --tool-radius 0.25 --scallop-height 0.001 --out m");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  EXPECT_NE(result.err.find("raster on paper1.stl: 4608 triangles"), std::string::npos) << result.err;
+  const auto report = nlohmann::json::parse(readFile(workDir_ / "m" / "report.json"));
+  EXPECT_EQ(report["strategy"], "raster");
+  EXPECT_EQ(report["units"], "in");
+  // eps: 1e-6 of the mesh's bounding-box diagonal (sqrt(3^2 + 3^2 + 1.5^2) = 4.5 in at most).
+  const double eps = 4.5e-6;
+  EXPECT_LE(report["gouge"]["max_depth"].get<double>(), eps);
+  const auto& v = report["verification"];
+  // Vertically the simulator reads more where a ball beside the footprint's edge touches it at
+  // its equator: up to sqrt(2 R eps) (cut_simulation.hpp's gouge bound, the README).
+  std::printf("[          ] STL plan: simulated gouge %.3g in at (%.4f, %.4f)\n", v["max_gouge"].get<double>(),
+              v["max_gouge_at"][0].get<double>(), v["max_gouge_at"][1].get<double>());
+  EXPECT_LE(v["max_gouge"].get<double>(), std::sqrt(2.0 * 0.25 * eps));
+  EXPECT_EQ(v["rapids_cutting"].get<int>(), 0);
+  std::printf("[          ] STL plan: scallop max %.6f / 99%% %.6f in, above H %.5f in^2\n", v["max_scallop"].get<double>(),
+              v["scallop_p99"].get<double>(), v["uncut_area"].get<double>());
+  EXPECT_LT(v["scallop_p99"].get<double>(), 0.001);
+  EXPECT_TRUE(fs::exists(workDir_ / "m" / "verify.svg"));
+  const std::string rs274 = scallop::test::findRs274();
+  ASSERT_FALSE(rs274.empty()) << "LinuxCNC's rs274 was not found: install linuxcnc-uspace";
+  const scallop::test::Rs274Run interpreted = scallop::test::runRs274(rs274, readFile(workDir_ / "m" / "toolpath.ngc"));
+  EXPECT_EQ(interpreted.exitCode, 0) << interpreted.err;
+  // Surface options refused for a mesh, by name; nothing written.
+  for (const char* option : {"--strategy contour", "--patches 0", "--no-drop-envelope", "--constant-spacing"}) {
+    const RunResult refused = run(std::string("plan paper1.stl --units in --out x ") + option);
+    EXPECT_EQ(refused.exitCode, 1) << option;
+    EXPECT_NE(refused.err.find("not for a mesh"), std::string::npos) << refused.err;
+    EXPECT_FALSE(fs::exists(workDir_ / "x"));
+  }
 }
 
 // The main job's G-code, for both strategies and both dialects, goes through LinuxCNC's own
