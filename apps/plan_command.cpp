@@ -393,7 +393,7 @@ void addPlanCommand(CLI::App& app) {
       "report.json (with the simulated cut of the program), verify.svg (its heat map), "
       "paths.svg, paths-plan.svg, gauss-map.svg and stereographic.svg into "
       "scallop-out/ (or --out DIR), all or nothing.");
-  addSurfaceSourceOptions(*plan, options->surface, "surface file (JSON or .bpt; .step/.stp or .iges/.igs); - reads standard input",
+  addSurfaceSourceOptions(*plan, options->surface, "surface file (JSON or .bpt; .step/.stp or .iges/.igs; .stl: a triangle mesh, cut by raster); - reads standard input",
                           "a built-in example (default paper-1)");
   addStrategyOption(*plan, options->strategy);
   plan->add_option("--tool-radius", options->toolRadius, "ball radius R (default 0.25 in or 6 mm)")

@@ -130,7 +130,7 @@ std::string sourceName(const SurfaceSource& source) {
 }
 
 void addStrategyOption(CLI::App& command, std::string& strategy) {
-  command.add_option("--strategy", strategy, "contour (default) or raster")
+  command.add_option("--strategy", strategy, "contour (default for a surface) or raster (always for an STL mesh)")
       ->check(CLI::IsMember({"contour", "raster"}))
       ->type_name("NAME");
 }
