@@ -71,6 +71,9 @@ void runPaths(const PathsOptions& options) {
   job.constantSpacing = options.constantSpacing;
   job.linking.direction = options.oneWay ? PassDirection::keep : PassDirection::zigzag;
 
+  if (isStlPath(options.surface.input))
+    throw Error(fmt::format("{}: paths takes Bezier surfaces (JSON, .bpt, STEP, IGES); an STL mesh goes through "
+                            "scallop plan (raster by exact drop lines)", options.surface.input));
   const Surface surface = loadSurface(options.surface);
   const std::string source = sourceName(options.surface);
   const double rapidRate = options.rapidRate.empty()
