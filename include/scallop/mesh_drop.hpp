@@ -56,7 +56,13 @@
 //         every output move keeps every centre on it at least R - eps from the mesh
 //         (segmentDistance, less a rounding allowance of 64 u (S + R)), so the ball cuts no
 //         deeper than eps; a move still unproven after kMeshMaxHalvings halvings is kept and
-//         counted (DropLine::unprovenMoves).
+//         counted (DropLine::unprovenMoves). The sag check is vertical and at midpoints
+//         only: where Z is vertical (the silhouette, a contact at the ball's equator) a chord
+//         can lie further below Z vertically (OpenCAMLib's sphere.stl: 0.0135 at R = 3.46)
+//         while its proven depth, measured along the normal as a cut is, stays below eps; and
+//         a valley narrower than the stations' spacing could be bridged with more material
+//         left than the sag tolerance (measured on OpenCAMLib's parts: the ball's gap to the
+//         part along the moves stayed below eps).
 // Index:  a uniform grid over the xy plane, the facets, the distinct edges and the vertices
 //         listed per cell their xy box covers; a query visits the cells its box (the point
 //         grown by R, the segment by the cutoff) covers and handles each feature once (only
@@ -65,7 +71,9 @@
 //         because tessellated parts have triangles of similar size: a cell is addressed
 //         directly, with no tree descent, and the distinct edges and vertices (each edge and
 //         vertex once, not once per triangle: about 3 and 6 times fewer evaluations) sit
-//         next to the facets.
+//         next to the facets. A drop visits its cells highest first (each cell's highest
+//         feature z + R bounds what its features can give) and stops at the first cell whose
+//         bound is not above the best height found: on a terrain most of the disk is skipped.
 // Complexity: building O(n) for n triangles (the edges sorted: O(n log n)); drop O(k) for k
 //         features within about R + one cell; segmentDistance O(k) likewise around the
 //         segment; dropLine O(m) drops and proofs for m output vertices, m about
@@ -183,6 +191,7 @@ class MeshDropCutter {
     double length = 0.0;        // horizontal length l
     double tanTheta = 0.0, secTheta = 0.0, sinTheta = 0.0;
     double lox = 0, loy = 0, hix = 0, hiy = 0;
+    double top = 0.0;           // the higher end's z
     std::uint32_t a = 0, b = 0;
     std::uint32_t triangle = 0;
     std::int32_t cx = 0, cy = 0;
@@ -212,6 +221,9 @@ class MeshDropCutter {
   std::vector<Vertex> vertices_;
   // Per cell (row-major, plus one sentinel), the start of its lists in the arrays below.
   std::vector<Cell> cells_;
+  // Per cell, the highest z of the features listed in it (-infinity: none): no feature of it
+  // can hold the ball higher than that + R.
+  std::vector<double> cellTop_;
   std::vector<std::uint32_t> cellFacets_, cellEdges_, cellVertices_;
 };
 
