@@ -213,6 +213,7 @@ MeshDropCutter::MeshDropCutter(const Mesh& mesh, double radius, const MeshDropOp
     e.tanTheta = rise / l;
     e.secTheta = length3 / l;
     e.sinTheta = rise / length3;
+    e.top = std::max(p.z, q.z);
     e.lox = std::min(p.x, q.x);
     e.hix = std::max(p.x, q.x);
     e.loy = std::min(p.y, q.y);
@@ -289,6 +290,17 @@ MeshDropCutter::MeshDropCutter(const Mesh& mesh, double radius, const MeshDropOp
     forCells(v.p.x, v.p.y, v.p.x, v.p.y,
              [&](std::size_t c) { cellVertices_[fill[c].vertexBegin++] = static_cast<std::uint32_t>(i); });
   }
+  cellTop_.assign(cellCount, -kInf);
+  for (std::size_t c = 0; c < cellCount; ++c) {
+    double top = -kInf;
+    for (std::uint32_t k = cells_[c].facetBegin; k < cells_[c + 1].facetBegin; ++k)
+      top = std::max(top, facets_[cellFacets_[k]].hi.z);
+    for (std::uint32_t k = cells_[c].edgeBegin; k < cells_[c + 1].edgeBegin; ++k)
+      top = std::max(top, edges_[cellEdges_[k]].top);
+    for (std::uint32_t k = cells_[c].vertexBegin; k < cells_[c + 1].vertexBegin; ++k)
+      top = std::max(top, vertices_[cellVertices_[k]].p.z);
+    cellTop_[c] = top;
+  }
 }
 
 // Cell coordinates, clamped to the grid: monotone in x, so a feature's box and a query's box
@@ -318,14 +330,43 @@ MeshContact MeshDropCutter::drop(double x, double y) const {
   const Vec2 p{x, y};
   const double qx0 = x - r, qx1 = x + r, qy0 = y - r, qy1 = y + r;
   const std::int32_t cx0 = cellX(qx0), cx1 = cellX(qx1), cy0 = cellY(qy0), cy1 = cellY(qy1);
-  MeshContact best;
+  // The cells highest first (ties by index: deterministic), so that the best height found
+  // early stops the visit: a feature can hold the ball at most R above its highest point, and
+  // a feature is listed in the cell where it is handled, whose top is at least its own.
+  struct Visit {
+    double top;
+    std::int32_t cx, cy;
+    std::size_t c;
+  };
+  constexpr std::size_t kMaxSorted = 64;
+  std::array<Visit, kMaxSorted> sorted;
+  std::vector<Visit> many;
+  const std::size_t count = static_cast<std::size_t>(cx1 - cx0 + 1) * static_cast<std::size_t>(cy1 - cy0 + 1);
+  Visit* visits = sorted.data();
+  if (count > kMaxSorted) {
+    many.resize(count);
+    visits = many.data();
+  }
+  std::size_t n = 0;
   for (std::int32_t cy = cy0; cy <= cy1; ++cy)
     for (std::int32_t cx = cx0; cx <= cx1; ++cx) {
       const std::size_t c = static_cast<std::size_t>(cy) * static_cast<std::size_t>(nx_) + static_cast<std::size_t>(cx);
+      if (cellTop_[c] > -kInf) visits[n++] = {cellTop_[c], cx, cy, c};
+    }
+  std::sort(visits, visits + n, [](const Visit& a, const Visit& b) {
+    return a.top > b.top || (a.top == b.top && a.c < b.c);
+  });
+  MeshContact best;
+  for (std::size_t j = 0; j < n; ++j) {
+    if (visits[j].top + r <= best.z) break;
+    const std::int32_t cx = visits[j].cx, cy = visits[j].cy;
+    const std::size_t c = visits[j].c;
+    {
       for (std::uint32_t k = cells_[c].facetBegin; k < cells_[c + 1].facetBegin; ++k) {
         const std::uint32_t i = cellFacets_[k];
         const Facet& f = facets_[i];
         if (f.rnz <= 0.0 || f.lo.x > qx1 || f.hi.x < qx0 || f.lo.y > qy1 || f.hi.y < qy0) continue;
+        if (f.hi.z + r <= best.z) continue;
         if (cx != std::max(f.cx, cx0) || cy != std::max(f.cy, cy0)) continue;
         // The contact c = C - R n is known in xy before the height: c_xy = p - R n_xy. Its
         // barycentric weights (edge functions over their sum) interpolate the vertex heights.
@@ -342,6 +383,7 @@ MeshContact MeshDropCutter::drop(double x, double y) const {
       for (std::uint32_t k = cells_[c].edgeBegin; k < cells_[c + 1].edgeBegin; ++k) {
         const Edge& e = edges_[cellEdges_[k]];
         if (e.lox > qx1 || e.hix < qx0 || e.loy > qy1 || e.hiy < qy0) continue;
+        if (e.top + r <= best.z) continue;
         if (cx != std::max(e.cx, cx0) || cy != std::max(e.cy, cy0)) continue;
         const Vec2 w{x - e.p0.x, y - e.p0.y};
         const double t = dot(w, e.dir);
@@ -365,6 +407,7 @@ MeshContact MeshDropCutter::drop(double x, double y) const {
         if (z > best.z) best = {z, MeshFeature::vertex, v.triangle, {v.index, v.index}};
       }
     }
+  }
   return best;
 }
 
@@ -455,9 +498,16 @@ struct LineContext {
       push(b);
       return;
     }
-    // The sag check first: it costs one drop, which the halving reuses.
+    // The sag check first, at the quarter points and the midpoint (the halving reuses the
+    // midpoint): drops are cheaper than a proof. Three points, not one: next to a steep
+    // stretch the envelope's largest sag above a chord sits off its middle (over an arc
+    // z = sqrt(2 R s) from a silhouette, at a quarter of the chord).
     DropLineVertex m = at(tm);
-    if (m.centre.z >= 0.5 * (a.centre.z + b.centre.z) - sag) {
+    const auto sagAt = [&](const DropLineVertex& v, double f) {
+      return v.centre.z >= a.centre.z + f * (b.centre.z - a.centre.z) - sag;
+    };
+    if (sagAt(m, 0.5) && sagAt(at(a.t + 0.25 * (b.t - a.t)), 0.25) &&
+        sagAt(at(a.t + 0.75 * (b.t - a.t)), 0.75)) {
       ++out->proofs;
       if (cutter->segmentClear(a.centre, b.centre, clearance)) {
         push(b);

@@ -51,12 +51,21 @@
 //         (floor default: the mesh's lowest z + R, a ball standing on the part's base level
 //         off the part), t increasing, both ends included; stations every `step` (default
 //         R / 4), then each move refined by halving where it is not proven, or where the
-//         drop at its midpoint lies more than `sagTolerance` below the chord (material that
-//         the straight move would leave: a midpoint check, not a proof). What is proven:
-//         every output move keeps every centre on it at least R - eps from the mesh
-//         (segmentDistance, less a rounding allowance of 64 u (S + R)), so the ball cuts no
+//         drop at its midpoint or quarter points lies more than `sagTolerance` below the
+//         chord (material that the straight move would leave: a check at three points, not
+//         a proof). What is proven: every output move keeps every centre on it at least
+//         R - eps from the mesh (segmentDistance, less a rounding allowance of
+//         64 u (S + R)), so the ball cuts no
 //         deeper than eps; a move still unproven after kMeshMaxHalvings halvings is kept and
-//         counted (DropLine::unprovenMoves).
+//         counted (DropLine::unprovenMoves). Depth is proven along the normal, as a cut
+//         is: measured vertically, a chord can lie further below Z where the touching
+//         surface is steep (up to 0.0135 at the silhouette of OpenCAMLib's sphere.stl, R =
+//         3.46, eps = 1.7e-4; 9.3e-4 on mount_rush.stl's moves of slope <= 1, eps = 1e-4),
+//         and where Z jumps (a wall's top edge leaving the ball at its equator) every
+//         polyline has a near-vertical move. Material left is only checked: the ball's gap
+//         to the part along the moves, sampled 32 times a move on four of OpenCAMLib's parts
+//         (20 lines each, R = 2% of the size, eps = sag tolerance = 1e-6 of the size), was
+//         at most eps on three and 1.9 eps on mount_rush.stl.
 // Index:  a uniform grid over the xy plane, the facets, the distinct edges and the vertices
 //         listed per cell their xy box covers; a query visits the cells its box (the point
 //         grown by R, the segment by the cutoff) covers and handles each feature once (only
@@ -65,7 +74,9 @@
 //         because tessellated parts have triangles of similar size: a cell is addressed
 //         directly, with no tree descent, and the distinct edges and vertices (each edge and
 //         vertex once, not once per triangle: about 3 and 6 times fewer evaluations) sit
-//         next to the facets.
+//         next to the facets. A drop visits its cells highest first (each cell's highest
+//         feature z + R bounds what its features can give) and stops at the first cell whose
+//         bound is not above the best height found: on a terrain most of the disk is skipped.
 // Complexity: building O(n) for n triangles (the edges sorted: O(n log n)); drop O(k) for k
 //         features within about R + one cell; segmentDistance O(k) likewise around the
 //         segment; dropLine O(m) drops and proofs for m output vertices, m about
@@ -183,6 +194,7 @@ class MeshDropCutter {
     double length = 0.0;        // horizontal length l
     double tanTheta = 0.0, secTheta = 0.0, sinTheta = 0.0;
     double lox = 0, loy = 0, hix = 0, hiy = 0;
+    double top = 0.0;           // the higher end's z
     std::uint32_t a = 0, b = 0;
     std::uint32_t triangle = 0;
     std::int32_t cx = 0, cy = 0;
@@ -212,6 +224,9 @@ class MeshDropCutter {
   std::vector<Vertex> vertices_;
   // Per cell (row-major, plus one sentinel), the start of its lists in the arrays below.
   std::vector<Cell> cells_;
+  // Per cell, the highest z of the features listed in it (-infinity: none): no feature of it
+  // can hold the ball higher than that + R.
+  std::vector<double> cellTop_;
   std::vector<std::uint32_t> cellFacets_, cellEdges_, cellVertices_;
 };
 
