@@ -111,6 +111,7 @@
 //         deepest sample wins a tie). The report is the same for any number of threads.
 
 #include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <vector>
 
@@ -221,6 +222,9 @@ class SurfaceDistance {
   DistanceOptions options_;
   double tolerance_ = 0.0;
   std::vector<detail::PatchTree> trees_;  // one per patch
+  // Tells this engine's cells apart in the per-thread store of halved cells (gouge.cpp);
+  // unique per construction, kept by copies (their trees are the same).
+  std::uint64_t id_ = 0;
 };
 
 /// The distance from p to the surface (builds a SurfaceDistance for this one query).
