@@ -17,6 +17,10 @@
 #include <thread>
 #include <vector>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include <fmt/format.h>
 
 #include "scallop/error.hpp"
@@ -98,6 +102,45 @@ double boxDistance(const Box& box, Vec3 p) {
   return std::sqrt(dx * dx + dy * dy + dz * dz);
 }
 
+// min_i (net[i] - origin) . w over `count` control points (net[i] . w without Shifted),
+// each dot product rounded as dot() rounds it ((x wx + y wy) + z wz, after the
+// subtraction). With SSE2 two points at a time (min is exact, so only the order of equal
+// values can differ: the same minimum).
+template <bool Shifted>
+double leastAlong(const Vec3* net, int count, Vec3 origin, Vec3 w) {
+  double least = kInfinity;
+  int i = 0;
+#if defined(__SSE2__)
+  static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 is read as packed doubles");
+  const double* c = &net[0].x;
+  const __m128d wx = _mm_set1_pd(w.x), wy = _mm_set1_pd(w.y), wz = _mm_set1_pd(w.z);
+  const __m128d ox = _mm_set1_pd(origin.x), oy = _mm_set1_pd(origin.y), oz = _mm_set1_pd(origin.z);
+  __m128d pair = _mm_set1_pd(kInfinity);
+  for (; i + 1 < count; i += 2) {
+    const double* q = c + 3 * i;  // x0 y0 | z0 x1 | y1 z1
+    const __m128d a = _mm_loadu_pd(q);
+    const __m128d b = _mm_loadu_pd(q + 2);
+    const __m128d d = _mm_loadu_pd(q + 4);
+    __m128d x = _mm_shuffle_pd(a, b, 0b10);
+    __m128d y = _mm_shuffle_pd(a, d, 0b01);
+    __m128d z = _mm_shuffle_pd(b, d, 0b10);
+    if constexpr (Shifted) {
+      x = _mm_sub_pd(x, ox);
+      y = _mm_sub_pd(y, oy);
+      z = _mm_sub_pd(z, oz);
+    }
+    const __m128d dots =
+        _mm_add_pd(_mm_add_pd(_mm_mul_pd(x, wx), _mm_mul_pd(y, wy)), _mm_mul_pd(z, wz));
+    pair = _mm_min_pd(dots, pair);  // dots < pair ? dots : pair, as std::min(pair, dots)
+  }
+  double lanes[2];
+  _mm_storeu_pd(lanes, pair);
+  least = std::min(lanes[0], lanes[1]);
+#endif
+  for (; i < count; ++i) least = std::min(least, dot(Shifted ? net[i] - origin : net[i], w));
+  return least;
+}
+
 // A separating plane: with w the unit direction from p to the mean of the net's corners,
 // every point of the convex hull, hence of the cell, is at least min_i (c_i - p) . w from
 // p (see the contract: near the foot point w tends to the normal, along which the net is
@@ -109,10 +152,7 @@ double separatingPlaneDistance(const Vec3* net, int m, int n, Vec3 p) {
   const double length = norm(toCell);
   if (!(length > 0.0)) return 0.0;
   const Vec3 w = toCell / length;
-  double least = kInfinity;
-  const int count = (m + 1) * stride;
-  for (int i = 0; i < count; ++i) least = std::min(least, dot(net[i] - p, w));
-  return std::max(0.0, least);
+  return std::max(0.0, leastAlong<true>(net, (m + 1) * stride, p, w));
 }
 
 // De Casteljau at 1/2 on b[0], b[s], .., b[n s] into left and right (n + 1 points each,
@@ -792,23 +832,32 @@ ClosestPoint search(const Surface& surface, const std::vector<PatchTree>& trees,
 // Segment clearance
 // ---------------------------------------------------------------------------------------
 
-// The point of the segment [a, b] nearest to p.
-Vec3 nearestOnSegment(Vec3 a, Vec3 b, Vec3 p) {
-  const Vec3 ab = b - a;
-  const double length2 = dot(ab, ab);
-  if (!(length2 > 0.0)) return a;
-  return a + std::clamp(dot(p - a, ab) / length2, 0.0, 1.0) * ab;
+// The segment [a, b] of a clearance query, with what every cell's bounds take from it
+// (computed once per query, the same values as per cell).
+struct QuerySegment {
+  Vec3 a, b;
+  Vec3 ab;         // b - a
+  double length2;  // dot(ab, ab)
+  Vec3 lo, hi;     // its box
+  explicit QuerySegment(Vec3 a_, Vec3 b_)
+      : a(a_), b(b_), ab(b_ - a_), length2(dot(ab, ab)),
+        lo{std::min(a_.x, b_.x), std::min(a_.y, b_.y), std::min(a_.z, b_.z)},
+        hi{std::max(a_.x, b_.x), std::max(a_.y, b_.y), std::max(a_.z, b_.z)} {}
+};
+
+// The point of the segment nearest to p.
+Vec3 nearestOnSegment(const QuerySegment& s, Vec3 p) {
+  if (!(s.length2 > 0.0)) return s.a;
+  return s.a + std::clamp(dot(p - s.a, s.ab) / s.length2, 0.0, 1.0) * s.ab;
 }
 
-// A lower bound of the distance between a box and the segment [a, b]: the gap between the
-// box and the segment's own box (exact for an axis-parallel segment, loose for a diagonal
-// one; the separating plane below takes over there).
-double boxSegmentDistance(const Box& box, Vec3 a, Vec3 b) {
-  const Vec3 lo{std::min(a.x, b.x), std::min(a.y, b.y), std::min(a.z, b.z)};
-  const Vec3 hi{std::max(a.x, b.x), std::max(a.y, b.y), std::max(a.z, b.z)};
-  const double dx = std::max({0.0, box.lo.x - hi.x, lo.x - box.hi.x});
-  const double dy = std::max({0.0, box.lo.y - hi.y, lo.y - box.hi.y});
-  const double dz = std::max({0.0, box.lo.z - hi.z, lo.z - box.hi.z});
+// A lower bound of the distance between a box and the segment: the gap between the box and
+// the segment's own box (exact for an axis-parallel segment, loose for a diagonal one; the
+// separating plane below takes over there).
+double boxSegmentDistance(const Box& box, const QuerySegment& s) {
+  const double dx = std::max({0.0, box.lo.x - s.hi.x, s.lo.x - box.hi.x});
+  const double dy = std::max({0.0, box.lo.y - s.hi.y, s.lo.y - box.hi.y});
+  const double dz = std::max({0.0, box.lo.z - s.hi.z, s.lo.z - box.hi.z});
   return std::sqrt(dx * dx + dy * dy + dz * dz);
 }
 
@@ -818,17 +867,15 @@ double boxSegmentDistance(const Box& box, Vec3 a, Vec3 b) {
 // max(a . w, b . w) (a linear function's maximum is at an end), so their distance is at
 // least the difference. Near a contact w tends to the common normal, along which the net is
 // O(h^2) thin and a segment tangent to the offset surface O(length^2) thick.
-double separatingPlaneSegmentDistance(const Vec3* net, int m, int n, Vec3 a, Vec3 b) {
+double separatingPlaneSegmentDistance(const Vec3* net, int m, int n, const QuerySegment& s) {
   const int stride = n + 1;
   const Vec3 mean = 0.25 * (net[0] + net[n] + net[m * stride] + net[m * stride + n]);
-  const Vec3 toCell = mean - nearestOnSegment(a, b, mean);
+  const Vec3 toCell = mean - nearestOnSegment(s, mean);
   const double length = norm(toCell);
   if (!(length > 0.0)) return 0.0;
   const Vec3 w = toCell / length;
-  double least = kInfinity;
-  const int count = (m + 1) * stride;
-  for (int i = 0; i < count; ++i) least = std::min(least, dot(net[i], w));
-  return std::max(0.0, least - std::max(dot(a, w), dot(b, w)));
+  const double least = leastAlong<false>(net, (m + 1) * stride, {}, w);
+  return std::max(0.0, least - std::max(dot(s.a, w), dot(s.b, w)));
 }
 
 SegmentClearance segmentSearch(const std::vector<PatchTree>& trees, std::uint64_t id, Vec3 a, Vec3 b,
@@ -844,11 +891,12 @@ SegmentClearance segmentSearch(const std::vector<PatchTree>& trees, std::uint64_
   heap.clear();
   store.prepare(id);
   SegmentClearance result;
+  const QuerySegment segment(a, b);
   const double pScale = std::max(maxAbs(a), maxAbs(b));
   // A surface point nearer than the clearance refutes it; the nearest seen is kept.
   bool violated = false;
   const auto consider = [&](Vec3 q, std::uint32_t patch, double u, double v) {
-    const double d = norm(q - nearestOnSegment(a, b, q));
+    const double d = norm(q - nearestOnSegment(segment, q));
     if (d < result.distance) {
       result.distance = d;
       result.patch = patch;
@@ -866,9 +914,9 @@ SegmentClearance segmentSearch(const std::vector<PatchTree>& trees, std::uint64_
     const double allowance = cellAllowance(tree, cell.depth, pScale);
     const int m = tree.degreeU;
     const int n = tree.degreeV;
-    double lower = boxSegmentDistance(box, a, b);
+    double lower = boxSegmentDistance(box, segment);
     if (lower - allowance < clearance) {
-      lower = std::max(lower, separatingPlaneSegmentDistance(net, m, n, a, b));
+      lower = std::max(lower, separatingPlaneSegmentDistance(net, m, n, segment));
     }
     cell.lower = lower - allowance;
     if (cell.lower >= clearance) return;  // proven clear
