@@ -65,6 +65,24 @@ double maxAbs(Vec3 a) { return std::max({std::abs(a.x), std::abs(a.y), std::abs(
 // registers across the unrolled loop; min and max are exact, so the same box).
 template <std::size_t Count>
 Box boxOfFixed(const Vec3* net) {
+#if defined(__SSE2__)
+  // x and y of each point as one pair, z alone: each coordinate's extremes taken in the same
+  // order as below (_mm_min_pd(a, b) is a < b ? a : b, std::min(b, a)), so the same bits.
+  static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 is read as packed doubles");
+  __m128d loXY = _mm_loadu_pd(&net[0].x);
+  __m128d hiXY = loXY;
+  double loZ = net[0].z, hiZ = loZ;
+  for (std::size_t i = 1; i < Count; ++i) {
+    const __m128d xy = _mm_loadu_pd(&net[i].x);
+    loXY = _mm_min_pd(xy, loXY);
+    hiXY = _mm_max_pd(xy, hiXY);
+    loZ = std::min(loZ, net[i].z), hiZ = std::max(hiZ, net[i].z);
+  }
+  double lo[2], hi[2];
+  _mm_storeu_pd(lo, loXY);
+  _mm_storeu_pd(hi, hiXY);
+  return {{lo[0], lo[1], loZ}, {hi[0], hi[1], hiZ}};
+#else
   double loX = net[0].x, loY = net[0].y, loZ = net[0].z;
   double hiX = loX, hiY = loY, hiZ = loZ;
   for (std::size_t i = 1; i < Count; ++i) {
@@ -72,6 +90,7 @@ Box boxOfFixed(const Vec3* net) {
     hiX = std::max(hiX, net[i].x), hiY = std::max(hiY, net[i].y), hiZ = std::max(hiZ, net[i].z);
   }
   return {{loX, loY, loZ}, {hiX, hiY, hiZ}};
+#endif
 }
 
 Box boxOf(const Vec3* net, std::size_t count) {
