@@ -52,20 +52,31 @@ double fallingFactorial(int n, int d) {
 // and du times along u, evaluate each row in v and the resulting column in u (de Casteljau),
 // and multiply by m!/(m-du)! n!/(n-dv)!. Differencing first keeps the derivative's rounding
 // relative to the differences, not to the coordinates.
-Vec3 partial(const BezierPatch& patch, double u, double v, int du, int dv) {
-  const int m = patch.degreeU;
-  const int n = patch.degreeV;
+// M, N, DU, DV >= 0 fix the degrees and orders at compile time (the bicubic patches the
+// drop envelope's Newton steps evaluate millions of times): the same operations in the same
+// order, so the same bits, unrolled.
+template <int M = -1, int N = -1, int DU = -1, int DV = -1>
+Vec3 partialImpl(const BezierPatch& patch, double u, double v, int duRuntime, int dvRuntime) {
+  constexpr bool kFixed = M >= 0;
+  const int m = kFixed ? M : patch.degreeU;
+  const int n = kFixed ? N : patch.degreeV;
+  const int du = kFixed ? DU : duRuntime;
+  const int dv = kFixed ? DV : dvRuntime;
   if (du > m || dv > n) return {};
   const int stride = n + 1;
-  constexpr std::size_t kSmall = 36;  // up to bidegree (5, 5) without allocation
-  std::array<Vec3, kSmall> small{};
+  constexpr std::size_t kSmall = kFixed ? static_cast<std::size_t>((M + 1) * (N + 1)) : 36;
+  std::array<Vec3, kSmall> small;  // up to bidegree (5, 5) without allocation; overwritten
   std::vector<Vec3> large;
   Vec3* net = small.data();
-  if (patch.control.size() > kSmall) {
+  if (!kFixed && patch.control.size() > kSmall) {
     large.resize(patch.control.size());
     net = large.data();
   }
-  std::copy(patch.control.begin(), patch.control.end(), net);
+  if constexpr (kFixed) {
+    std::copy_n(patch.control.begin(), kSmall, net);  // all of `small`, visibly
+  } else {
+    std::copy(patch.control.begin(), patch.control.end(), net);
+  }
   for (int j = 0; j <= m; ++j) {
     Vec3* row = net + j * stride;
     for (int d = 1; d <= dv; ++d) {
@@ -84,6 +95,22 @@ Vec3 partial(const BezierPatch& patch, double u, double v, int du, int dv) {
   return (fallingFactorial(m, du) * fallingFactorial(n, dv)) * deCasteljau(net, m - du, u);
 }
 
+Vec3 partial(const BezierPatch& patch, double u, double v, int du, int dv) {
+  if (patch.degreeU == 3 && patch.degreeV == 3 && patch.control.size() == 16 && du >= 0 &&
+      dv >= 0 && du + dv <= 2) {
+    switch (du * 3 + dv) {
+      case 0: return partialImpl<3, 3, 0, 0>(patch, u, v, 0, 0);
+      case 1: return partialImpl<3, 3, 0, 1>(patch, u, v, 0, 1);
+      case 3: return partialImpl<3, 3, 1, 0>(patch, u, v, 1, 0);
+      case 2: return partialImpl<3, 3, 0, 2>(patch, u, v, 0, 2);
+      case 4: return partialImpl<3, 3, 1, 1>(patch, u, v, 1, 1);
+      case 6: return partialImpl<3, 3, 2, 0>(patch, u, v, 2, 0);
+      default: break;
+    }
+  }
+  return partialImpl<>(patch, u, v, du, dv);
+}
+
 // B_j^d(t), dB_j^d/dt and d2B_j^d/dt2 for j = 0..d: the basis of degree d - 2 by the
 // triangle b^e_j = (1 - t) b^(e-1)_j + t b^(e-1)_(j-1), raised to d - 1 and d, with
 //   d/dt B_j^d = d (B_(j-1)^(d-1) - B_j^(d-1)),
@@ -92,8 +119,11 @@ Vec3 partial(const BezierPatch& patch, double u, double v, int du, int dv) {
 // Written into value[0..d], first[0..d] and second[0..d]: the triangle runs in place in
 // `value`, and the bases of degree d - 1 and d - 2 are kept in `first` and `second` on the
 // way, then differenced in place from the top index down (each entry reads only entries at
-// or below its own index, not yet overwritten).
-void basisDerivatives(int d, double t, double* value, double* first, double* second) {
+// or below its own index, not yet overwritten). D >= 0 fixes d at compile time (the same
+// operations, unrolled).
+template <int D = -1>
+void basisDerivatives(int dRuntime, double t, double* value, double* first, double* second) {
+  const int d = D >= 0 ? D : dRuntime;
   value[0] = 1.0;
   auto keep = [&](int e) {  // value[0..e] holds the basis of degree e
     if (e == d - 2) std::copy(value, value + e + 1, second);
@@ -337,10 +367,14 @@ CurvatureSign curvatureSignPolynomial(const BezierPatch& patch) {
   return out;
 }
 
-PatchDerivatives derivativesToSecondOrder(const BezierPatch& patch, double u, double v) {
-  requireValid(patch, "derivativesToSecondOrder");
-  const int m = patch.degreeU;
-  const int n = patch.degreeV;
+namespace {
+
+// derivativesToSecondOrder's sums; M, N >= 0 fix the degrees at compile time (the same
+// operations in the same order, unrolled).
+template <int M = -1, int N = -1>
+PatchDerivatives derivativesImpl(const BezierPatch& patch, double u, double v) {
+  const int m = M >= 0 ? M : patch.degreeU;
+  const int n = N >= 0 ? N : patch.degreeV;
   // Three rows of basis values per direction (value, first, second derivative), su and sv
   // apart; on the stack up to degree 15.
   constexpr int kSmall = 16;
@@ -355,8 +389,8 @@ PatchDerivatives derivativesToSecondOrder(const BezierPatch& patch, double u, do
     bu = large.data();
   }
   double* bv = bu + 3 * su;
-  basisDerivatives(m, u, bu, bu + su, bu + 2 * su);
-  basisDerivatives(n, v, bv, bv + sv, bv + 2 * sv);
+  basisDerivatives<M>(m, u, bu, bu + su, bu + 2 * su);
+  basisDerivatives<N>(n, v, bv, bv + sv, bv + 2 * sv);
   PatchDerivatives out{};
   for (int j = 0; j <= m; ++j) {
     Vec3 row0{}, row1{}, row2{};  // the row's sums with the v basis and its derivatives
@@ -373,6 +407,14 @@ PatchDerivatives derivativesToSecondOrder(const BezierPatch& patch, double u, do
     out.vv = out.vv + bu[j] * row2;
   }
   return out;
+}
+
+}  // namespace
+
+PatchDerivatives derivativesToSecondOrder(const BezierPatch& patch, double u, double v) {
+  requireValid(patch, "derivativesToSecondOrder");
+  if (patch.degreeU == 3 && patch.degreeV == 3) return derivativesImpl<3, 3>(patch, u, v);
+  return derivativesImpl<>(patch, u, v);
 }
 
 double gaussianCurvatureNumeratorAt(const BezierPatch& patch, double u, double v) {

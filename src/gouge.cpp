@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <cstddef>
@@ -15,6 +16,10 @@
 #include <string>
 #include <thread>
 #include <vector>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include <fmt/format.h>
 
@@ -60,6 +65,24 @@ double maxAbs(Vec3 a) { return std::max({std::abs(a.x), std::abs(a.y), std::abs(
 // registers across the unrolled loop; min and max are exact, so the same box).
 template <std::size_t Count>
 Box boxOfFixed(const Vec3* net) {
+#if defined(__SSE2__)
+  // x and y of each point as one pair, z alone: each coordinate's extremes taken in the same
+  // order as below (_mm_min_pd(a, b) is a < b ? a : b, std::min(b, a)), so the same bits.
+  static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 is read as packed doubles");
+  __m128d loXY = _mm_loadu_pd(&net[0].x);
+  __m128d hiXY = loXY;
+  double loZ = net[0].z, hiZ = loZ;
+  for (std::size_t i = 1; i < Count; ++i) {
+    const __m128d xy = _mm_loadu_pd(&net[i].x);
+    loXY = _mm_min_pd(xy, loXY);
+    hiXY = _mm_max_pd(xy, hiXY);
+    loZ = std::min(loZ, net[i].z), hiZ = std::max(hiZ, net[i].z);
+  }
+  double lo[2], hi[2];
+  _mm_storeu_pd(lo, loXY);
+  _mm_storeu_pd(hi, hiXY);
+  return {{lo[0], lo[1], loZ}, {hi[0], hi[1], hiZ}};
+#else
   double loX = net[0].x, loY = net[0].y, loZ = net[0].z;
   double hiX = loX, hiY = loY, hiZ = loZ;
   for (std::size_t i = 1; i < Count; ++i) {
@@ -67,6 +90,7 @@ Box boxOfFixed(const Vec3* net) {
     hiX = std::max(hiX, net[i].x), hiY = std::max(hiY, net[i].y), hiZ = std::max(hiZ, net[i].z);
   }
   return {{loX, loY, loZ}, {hiX, hiY, hiZ}};
+#endif
 }
 
 Box boxOf(const Vec3* net, std::size_t count) {
@@ -97,6 +121,45 @@ double boxDistance(const Box& box, Vec3 p) {
   return std::sqrt(dx * dx + dy * dy + dz * dz);
 }
 
+// min_i (net[i] - origin) . w over `count` control points (net[i] . w without Shifted),
+// each dot product rounded as dot() rounds it ((x wx + y wy) + z wz, after the
+// subtraction). With SSE2 two points at a time (min is exact, so only the order of equal
+// values can differ: the same minimum).
+template <bool Shifted>
+double leastAlong(const Vec3* net, int count, Vec3 origin, Vec3 w) {
+  double least = kInfinity;
+  int i = 0;
+#if defined(__SSE2__)
+  static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 is read as packed doubles");
+  const double* c = &net[0].x;
+  const __m128d wx = _mm_set1_pd(w.x), wy = _mm_set1_pd(w.y), wz = _mm_set1_pd(w.z);
+  const __m128d ox = _mm_set1_pd(origin.x), oy = _mm_set1_pd(origin.y), oz = _mm_set1_pd(origin.z);
+  __m128d pair = _mm_set1_pd(kInfinity);
+  for (; i + 1 < count; i += 2) {
+    const double* q = c + 3 * i;  // x0 y0 | z0 x1 | y1 z1
+    const __m128d a = _mm_loadu_pd(q);
+    const __m128d b = _mm_loadu_pd(q + 2);
+    const __m128d d = _mm_loadu_pd(q + 4);
+    __m128d x = _mm_shuffle_pd(a, b, 0b10);
+    __m128d y = _mm_shuffle_pd(a, d, 0b01);
+    __m128d z = _mm_shuffle_pd(b, d, 0b10);
+    if constexpr (Shifted) {
+      x = _mm_sub_pd(x, ox);
+      y = _mm_sub_pd(y, oy);
+      z = _mm_sub_pd(z, oz);
+    }
+    const __m128d dots =
+        _mm_add_pd(_mm_add_pd(_mm_mul_pd(x, wx), _mm_mul_pd(y, wy)), _mm_mul_pd(z, wz));
+    pair = _mm_min_pd(dots, pair);  // dots < pair ? dots : pair, as std::min(pair, dots)
+  }
+  double lanes[2];
+  _mm_storeu_pd(lanes, pair);
+  least = std::min(lanes[0], lanes[1]);
+#endif
+  for (; i < count; ++i) least = std::min(least, dot(Shifted ? net[i] - origin : net[i], w));
+  return least;
+}
+
 // A separating plane: with w the unit direction from p to the mean of the net's corners,
 // every point of the convex hull, hence of the cell, is at least min_i (c_i - p) . w from
 // p (see the contract: near the foot point w tends to the normal, along which the net is
@@ -108,10 +171,7 @@ double separatingPlaneDistance(const Vec3* net, int m, int n, Vec3 p) {
   const double length = norm(toCell);
   if (!(length > 0.0)) return 0.0;
   const Vec3 w = toCell / length;
-  double least = kInfinity;
-  const int count = (m + 1) * stride;
-  for (int i = 0; i < count; ++i) least = std::min(least, dot(net[i] - p, w));
-  return std::max(0.0, least);
+  return std::max(0.0, leastAlong<true>(net, (m + 1) * stride, p, w));
 }
 
 // De Casteljau at 1/2 on b[0], b[s], .., b[n s] into left and right (n + 1 points each,
@@ -209,8 +269,10 @@ CurveJet curveJet(Vec3* b, int n, double t) {
 }
 
 // The same with the degree fixed at compile time (the same operations, so the same bits).
+// Inlined by force into jetAt's seven calls (GCC 12 kept them calls: 2.5 % of the raster
+// plan's instructions).
 template <int N>
-CurveJet curveJetFixed(Vec3* b, double t) {
+[[gnu::always_inline]] inline CurveJet curveJetFixed(Vec3* b, double t) {
   static_assert(N >= 2);
   const double s = 1.0 - t;
   for (int count = N + 1; count > 3; --count) {
@@ -449,13 +511,14 @@ double convexLowerBound(const Vec3* net, const BezierPatch& patch, std::size_t p
 }
 
 // A cell of the search: a sub-patch of `patch` on [u0, u0 + h] x [v0, v0 + h], h = 2^-depth.
-// Its net is in the patch's tree (inTree, at `net` = node index) or in the query's arena
-// (at `net` = offset).
+// Its net is in the patch's tree (inTree, at `net` = node index) or in the thread's cell
+// store (at `net` = offset into its nets, its box at `box`).
 struct Cell {
   double lower = 0.0;
   std::uint32_t patch = 0;
   int depth = 0;
   bool inTree = false;
+  std::uint32_t box = 0;
   std::size_t net = 0;
   double u0 = 0.0;
   double v0 = 0.0;
@@ -465,40 +528,132 @@ struct ByLowerBound {
   bool operator()(const Cell& a, const Cell& b) const { return a.lower > b.lower; }  // min-heap
 };
 
+// The cells below the patches' trees, halved on demand, kept per thread across queries:
+// consecutive queries along a path (the drop envelope's proofs along a pass) search the same
+// small region, so they would halve the same cells again. Keyed by the split cell (patch,
+// depth, iu, iv), each entry holds its four quarters' nets and boxes, computed exactly as
+// halveNet and boxOf compute them, so a query gives the same bits whatever the store holds.
+// Bounded: emptied at the start of a query once it holds kStoreEntries splits (or cells of
+// another SurfaceDistance, told apart by its id); within a query it grows with the cells
+// split (past kStoreEntries they are kept but no longer indexed). 1024 splits of bicubic
+// cells are 1.7 MB; on paper-1's raster plan 256 kept 1 % more instructions, 4096 and
+// 16384 no fewer (the drop envelope's proofs along a pass reuse only recent cells).
+constexpr std::size_t kStoreEntries = 1024;
+constexpr std::size_t kStoreSlots = 4 * kStoreEntries;  // a power of 2; at most 1/4 full
+
+struct CellStore {
+  struct Slot {
+    std::uint64_t iu = 0;
+    std::uint64_t iv = 0;
+    std::uint32_t patch = 0;
+    int depth = -1;  // -1: empty
+    std::size_t net = 0;
+    std::uint32_t box = 0;
+  };
+  std::uint64_t owner = 0;  // SurfaceDistance::id_ of the cells held; 0: none
+  std::vector<Vec3> nets;   // [0, netsUsed) in use; never shrunk, so never re-zeroed
+  std::size_t netsUsed = 0;
+  std::vector<Box> boxes;
+  std::size_t boxesUsed = 0;
+  std::vector<Slot> slots = std::vector<Slot>(kStoreSlots);
+  std::size_t entries = 0;
+
+  // Before a query of the SurfaceDistance `id`.
+  void prepare(std::uint64_t id) {
+    if (owner == id && entries < kStoreEntries && boxesUsed <= 4 * kStoreEntries) return;
+    owner = id;
+    netsUsed = 0;
+    boxesUsed = 0;
+    if (entries > 0) std::fill(slots.begin(), slots.end(), Slot{});
+    entries = 0;
+  }
+
+  static std::size_t hash(std::uint64_t iu, std::uint64_t iv, std::uint32_t patch, int depth) {
+    std::uint64_t k = iu * 0x9E3779B97F4A7C15ULL ^ (iv + 0x632BE59BD9B4E019ULL) * 0xC2B2AE3D27D4EB4FULL;
+    k ^= (static_cast<std::uint64_t>(patch) << 8 | static_cast<std::uint64_t>(depth)) * 0x165667B19E3779F9ULL;
+    return static_cast<std::size_t>(k ^ (k >> 29)) & (kStoreSlots - 1);
+  }
+
+  // The quarters of the cell (patch, depth, iu, iv) with the net `parent` (m, n its
+  // degrees): where its nets (4 (m + 1)(n + 1) points from the offset returned in `net`) and
+  // boxes (4 from `box`) are, halved now unless held.
+  void quarters(std::uint32_t patch, int depth, std::uint64_t iu, std::uint64_t iv, const Vec3* parent,
+                const PatchTree& tree, std::size_t& net, std::uint32_t& box) {
+    std::size_t slot = hash(iu, iv, patch, depth);
+    for (;; slot = (slot + 1) & (kStoreSlots - 1)) {
+      const Slot& s = slots[slot];
+      if (s.depth < 0) break;
+      if (s.iu == iu && s.iv == iv && s.patch == patch && s.depth == depth) {
+        net = s.net;
+        box = s.box;
+        return;
+      }
+    }
+    const std::size_t stride = tree.stride;
+    net = netsUsed;
+    netsUsed += 4 * stride;
+    if (netsUsed > nets.size()) {
+      // Growing moves the nets: copy the parent first if it lives here.
+      std::vector<Vec3> copy(parent, parent + stride);
+      nets.resize(std::max(netsUsed, 2 * nets.size()));
+      halveNet(copy.data(), tree.degreeU, tree.degreeV, nets.data() + net);
+    } else {
+      halveNet(parent, tree.degreeU, tree.degreeV, nets.data() + net);
+    }
+    box = static_cast<std::uint32_t>(boxesUsed);
+    boxesUsed += 4;
+    if (boxesUsed > boxes.size()) boxes.resize(std::max(boxesUsed, 2 * boxes.size()));
+    for (std::size_t k = 0; k < 4; ++k) boxes[box + k] = boxOf(nets.data() + net + k * stride, stride);
+    if (entries < kStoreSlots / 4) {
+      slots[slot] = {iu, iv, patch, depth, net, box};
+      ++entries;
+    }
+  }
+};
+
 // What both searches (closest point, segment clearance) do with a cell before their own
 // bounds: the rounding allowance of the contract for a cell `depth` halvings deep and queries
-// of magnitude `queryScale`; the cell's control net (in the tree, or in the scratch arena);
-// its four corners, surface points, offered to `consider`; and its axis-aligned box.
+// of magnitude `queryScale`; the cell's control net (in the tree, or in the cell store);
+// its corners not seen before (`fresh`, a bit per corner), surface points, offered to
+// `consider`; and its axis-aligned box.
 double cellAllowance(const PatchTree& tree, int depth, double queryScale) {
   return (3.0 * (tree.degreeU + tree.degreeV) * (depth + 1) + 16.0) * kUnitRoundoff * (tree.scale + queryScale);
 }
 
-const Vec3* cellNet(const PatchTree& tree, const Cell& cell, const std::vector<Vec3>& arena) {
+const Vec3* cellNet(const PatchTree& tree, const Cell& cell, const CellStore& store) {
   return cell.inTree ? tree.nets[static_cast<std::size_t>(cell.depth)].data() + cell.net * tree.stride
-                     : arena.data() + cell.net;
+                     : store.nets.data() + cell.net;
 }
 
+// Inlined by force: it runs for every cell, and GCC 12 left it a call that copied the box
+// out (4 % of the raster plan's instructions).
 template <class Consider>
-Box cornersAndBox(const PatchTree& tree, const Cell& cell, const Vec3* net, Consider&& consider) {
+[[gnu::always_inline]] inline Box cornersAndBox(const PatchTree& tree, const Cell& cell,
+                                                const Vec3* net, unsigned fresh,
+                                                const CellStore& store, Consider&& consider) {
   const int m = tree.degreeU;
   const int n = tree.degreeV;
   const double h = cellSide(cell.depth);
-  consider(net[0], cell.patch, cell.u0, cell.v0);
-  consider(net[n], cell.patch, cell.u0, cell.v0 + h);
-  consider(net[m * (n + 1)], cell.patch, cell.u0 + h, cell.v0);
-  consider(net[m * (n + 1) + n], cell.patch, cell.u0 + h, cell.v0 + h);
-  return cell.inTree ? tree.boxes[static_cast<std::size_t>(cell.depth)][cell.net] : boxOf(net, tree.stride);
+  if (fresh & 1u) consider(net[0], cell.patch, cell.u0, cell.v0);
+  if (fresh & 2u) consider(net[n], cell.patch, cell.u0, cell.v0 + h);
+  if (fresh & 4u) consider(net[m * (n + 1)], cell.patch, cell.u0 + h, cell.v0);
+  if (fresh & 8u) consider(net[m * (n + 1) + n], cell.patch, cell.u0 + h, cell.v0 + h);
+  return cell.inTree ? tree.boxes[static_cast<std::size_t>(cell.depth)][cell.net] : store.boxes[cell.box];
 }
 
 struct Scratch {
   std::vector<Cell> heap;
-  std::vector<Vec3> arena;
+  CellStore store;
 };
 
 // Offers the four quarters of `cell` (subdivided at 1/2 in u and v): from the patch's tree
-// while it goes that deep, else halved into the query's arena.
+// while it goes that deep, else from the cell store. Each quarter comes with the corners it
+// does not share with `cell` or an earlier quarter (the same points, bit for bit: de
+// Casteljau copies the ends), so that each surface point is considered once, in the order
+// the quarters' corners would first show it: `consider` keeps the first of equal distances.
 template <typename Offer>
-void offerQuarters(const Cell& cell, const PatchTree& tree, std::vector<Vec3>& arena, const Offer& offer) {
+void offerQuarters(const Cell& cell, const PatchTree& tree, CellStore& store, const Offer& offer) {
+  constexpr unsigned kFresh[2][2] = {{0b1110u, 0b1000u}, {0b1000u, 0b0000u}};
   const double half = cellSide(cell.depth + 1);
   if (cell.inTree && cell.depth + 1 < tree.levels) {
     const auto side = std::size_t{1} << cell.depth;
@@ -506,23 +661,27 @@ void offerQuarters(const Cell& cell, const PatchTree& tree, std::vector<Vec3>& a
     const std::size_t iv = cell.net % side;
     for (std::size_t a = 0; a < 2; ++a) {
       for (std::size_t b = 0; b < 2; ++b) {
-        offer(Cell{0.0, cell.patch, cell.depth + 1, true, (2 * iu + a) * (2 * side) + (2 * iv + b),
-                   cell.u0 + static_cast<double>(a) * half, cell.v0 + static_cast<double>(b) * half});
+        offer(Cell{0.0, cell.patch, cell.depth + 1, true, 0, (2 * iu + a) * (2 * side) + (2 * iv + b),
+                   cell.u0 + static_cast<double>(a) * half, cell.v0 + static_cast<double>(b) * half},
+              kFresh[a][b]);
       }
     }
     return;
   }
-  const std::size_t stride = tree.stride;
-  const std::size_t first = arena.size();
-  arena.resize(first + 4 * stride);  // may move the arena: take the parent's net after
-  const Vec3* parent = cell.inTree
-                           ? tree.nets[static_cast<std::size_t>(cell.depth)].data() + cell.net * stride
-                           : arena.data() + cell.net;
-  halveNet(parent, tree.degreeU, tree.degreeV, arena.data() + first);
+  // The cell's integer position at its depth (u0, v0 are exact multiples of its side).
+  const double cells = cellSide(-cell.depth);
+  const auto iu = static_cast<std::uint64_t>(cell.u0 * cells);
+  const auto iv = static_cast<std::uint64_t>(cell.v0 * cells);
+  std::size_t first = 0;
+  std::uint32_t box = 0;
+  store.quarters(cell.patch, cell.depth, iu, iv, cellNet(tree, cell, store), tree, first, box);
   for (std::size_t a = 0; a < 2; ++a) {
     for (std::size_t b = 0; b < 2; ++b) {
-      offer(Cell{0.0, cell.patch, cell.depth + 1, false, first + (2 * a + b) * stride,
-                 cell.u0 + static_cast<double>(a) * half, cell.v0 + static_cast<double>(b) * half});
+      const std::size_t k = 2 * a + b;
+      offer(Cell{0.0, cell.patch, cell.depth + 1, false, box + static_cast<std::uint32_t>(k),
+                 first + k * tree.stride, cell.u0 + static_cast<double>(a) * half,
+                 cell.v0 + static_cast<double>(b) * half},
+            kFresh[a][b]);
     }
   }
 }
@@ -594,8 +753,8 @@ PatchTree buildTree(const BezierPatch& patch, int depth) {
 }
 
 // The branch and bound of the contract.
-ClosestPoint search(const Surface& surface, const std::vector<PatchTree>& trees, double tolerance,
-                    std::size_t maxCells, Vec3 p, double cutoff) {
+ClosestPoint search(const Surface& surface, const std::vector<PatchTree>& trees, std::uint64_t id,
+                    double tolerance, std::size_t maxCells, Vec3 p, double cutoff) {
   if (!isFinite(p)) {
     throw Error(
         fmt::format("surface distance: the query point ({}, {}, {}) is not finite", p.x, p.y, p.z));
@@ -603,9 +762,9 @@ ClosestPoint search(const Surface& surface, const std::vector<PatchTree>& trees,
   if (std::isnan(cutoff)) throw Error("surface distance: the cutoff is NaN");
   thread_local Scratch scratch;
   std::vector<Cell>& heap = scratch.heap;
-  std::vector<Vec3>& arena = scratch.arena;
+  CellStore& store = scratch.store;
   heap.clear();
-  arena.clear();
+  store.prepare(id);
 
   Candidate best;
   double setAside = kInfinity;  // the least lower bound of the cells dropped
@@ -619,11 +778,11 @@ ClosestPoint search(const Surface& surface, const std::vector<PatchTree>& trees,
   // Bounds a new cell: its corners are surface points (upper bounds); then its lower bound,
   // the axis-aligned box first (cheap, precomputed in the tree) and the separating plane
   // only if the cell survives that; then queued or set aside.
-  const auto offer = [&](Cell cell) {
+  const auto offer = [&](Cell cell, unsigned fresh) {
     ++cells;
     const PatchTree& tree = trees[cell.patch];
-    const Vec3* net = cellNet(tree, cell, arena);
-    const Box box = cornersAndBox(tree, cell, net, consider);
+    const Vec3* net = cellNet(tree, cell, store);
+    const Box box = cornersAndBox(tree, cell, net, fresh, store, consider);
     const double allowance = cellAllowance(tree, cell.depth, pScale);
     const int m = tree.degreeU;
     const int n = tree.degreeV;
@@ -639,7 +798,7 @@ ClosestPoint search(const Surface& surface, const std::vector<PatchTree>& trees,
   };
 
   for (std::size_t i = 0; i < trees.size(); ++i) {
-    offer({0.0, static_cast<std::uint32_t>(i), 0, true, 0, 0.0, 0.0});
+    offer({0.0, static_cast<std::uint32_t>(i), 0, true, 0, 0, 0.0, 0.0}, 0b1111u);
   }
   double lowerBound = kInfinity;  // of the cells still queued when the search stops
   while (!heap.empty()) {
@@ -666,7 +825,7 @@ ClosestPoint search(const Surface& surface, const std::vector<PatchTree>& trees,
     }
     const PatchTree& tree = trees[cell.patch];
     const double convex =
-        convexLowerBound(cellNet(tree, cell, arena), patch, cell.patch, cell.u0, cell.v0, h, best, p) -
+        convexLowerBound(cellNet(tree, cell, store), patch, cell.patch, cell.u0, cell.v0, h, best, p) -
         cellAllowance(tree, cell.depth, pScale);
     if (convex >= level()) {
       setAside = std::min(setAside, std::max(cell.lower, convex));
@@ -680,7 +839,7 @@ ClosestPoint search(const Surface& surface, const std::vector<PatchTree>& trees,
       lowerBound = cell.lower;
       break;
     }
-    offerQuarters(cell, tree, arena, offer);
+    offerQuarters(cell, tree, store, offer);
   }
 
   ClosestPoint result;
@@ -699,23 +858,32 @@ ClosestPoint search(const Surface& surface, const std::vector<PatchTree>& trees,
 // Segment clearance
 // ---------------------------------------------------------------------------------------
 
-// The point of the segment [a, b] nearest to p.
-Vec3 nearestOnSegment(Vec3 a, Vec3 b, Vec3 p) {
-  const Vec3 ab = b - a;
-  const double length2 = dot(ab, ab);
-  if (!(length2 > 0.0)) return a;
-  return a + std::clamp(dot(p - a, ab) / length2, 0.0, 1.0) * ab;
+// The segment [a, b] of a clearance query, with what every cell's bounds take from it
+// (computed once per query, the same values as per cell).
+struct QuerySegment {
+  Vec3 a, b;
+  Vec3 ab;         // b - a
+  double length2;  // dot(ab, ab)
+  Vec3 lo, hi;     // its box
+  explicit QuerySegment(Vec3 a_, Vec3 b_)
+      : a(a_), b(b_), ab(b_ - a_), length2(dot(ab, ab)),
+        lo{std::min(a_.x, b_.x), std::min(a_.y, b_.y), std::min(a_.z, b_.z)},
+        hi{std::max(a_.x, b_.x), std::max(a_.y, b_.y), std::max(a_.z, b_.z)} {}
+};
+
+// The point of the segment nearest to p.
+Vec3 nearestOnSegment(const QuerySegment& s, Vec3 p) {
+  if (!(s.length2 > 0.0)) return s.a;
+  return s.a + std::clamp(dot(p - s.a, s.ab) / s.length2, 0.0, 1.0) * s.ab;
 }
 
-// A lower bound of the distance between a box and the segment [a, b]: the gap between the
-// box and the segment's own box (exact for an axis-parallel segment, loose for a diagonal
-// one; the separating plane below takes over there).
-double boxSegmentDistance(const Box& box, Vec3 a, Vec3 b) {
-  const Vec3 lo{std::min(a.x, b.x), std::min(a.y, b.y), std::min(a.z, b.z)};
-  const Vec3 hi{std::max(a.x, b.x), std::max(a.y, b.y), std::max(a.z, b.z)};
-  const double dx = std::max({0.0, box.lo.x - hi.x, lo.x - box.hi.x});
-  const double dy = std::max({0.0, box.lo.y - hi.y, lo.y - box.hi.y});
-  const double dz = std::max({0.0, box.lo.z - hi.z, lo.z - box.hi.z});
+// A lower bound of the distance between a box and the segment: the gap between the box and
+// the segment's own box (exact for an axis-parallel segment, loose for a diagonal one; the
+// separating plane below takes over there).
+double boxSegmentDistance(const Box& box, const QuerySegment& s) {
+  const double dx = std::max({0.0, box.lo.x - s.hi.x, s.lo.x - box.hi.x});
+  const double dy = std::max({0.0, box.lo.y - s.hi.y, s.lo.y - box.hi.y});
+  const double dz = std::max({0.0, box.lo.z - s.hi.z, s.lo.z - box.hi.z});
   return std::sqrt(dx * dx + dy * dy + dz * dz);
 }
 
@@ -725,20 +893,19 @@ double boxSegmentDistance(const Box& box, Vec3 a, Vec3 b) {
 // max(a . w, b . w) (a linear function's maximum is at an end), so their distance is at
 // least the difference. Near a contact w tends to the common normal, along which the net is
 // O(h^2) thin and a segment tangent to the offset surface O(length^2) thick.
-double separatingPlaneSegmentDistance(const Vec3* net, int m, int n, Vec3 a, Vec3 b) {
+double separatingPlaneSegmentDistance(const Vec3* net, int m, int n, const QuerySegment& s) {
   const int stride = n + 1;
   const Vec3 mean = 0.25 * (net[0] + net[n] + net[m * stride] + net[m * stride + n]);
-  const Vec3 toCell = mean - nearestOnSegment(a, b, mean);
+  const Vec3 toCell = mean - nearestOnSegment(s, mean);
   const double length = norm(toCell);
   if (!(length > 0.0)) return 0.0;
   const Vec3 w = toCell / length;
-  double least = kInfinity;
-  const int count = (m + 1) * stride;
-  for (int i = 0; i < count; ++i) least = std::min(least, dot(net[i], w));
-  return std::max(0.0, least - std::max(dot(a, w), dot(b, w)));
+  const double least = leastAlong<false>(net, (m + 1) * stride, {}, w);
+  return std::max(0.0, least - std::max(dot(s.a, w), dot(s.b, w)));
 }
 
-SegmentClearance segmentSearch(const std::vector<PatchTree>& trees, Vec3 a, Vec3 b, double clearance, std::size_t maxCells) {
+SegmentClearance segmentSearch(const std::vector<PatchTree>& trees, std::uint64_t id, Vec3 a, Vec3 b,
+                               double clearance, std::size_t maxCells) {
   if (!isFinite(a) || !isFinite(b)) {
     throw Error(fmt::format("segment clearance: the segment ({}, {}, {}) - ({}, {}, {}) is not "
                             "finite", a.x, a.y, a.z, b.x, b.y, b.z));
@@ -746,15 +913,16 @@ SegmentClearance segmentSearch(const std::vector<PatchTree>& trees, Vec3 a, Vec3
   if (!std::isfinite(clearance)) throw Error("segment clearance: the clearance is not finite");
   thread_local Scratch scratch;
   std::vector<Cell>& heap = scratch.heap;
-  std::vector<Vec3>& arena = scratch.arena;
+  CellStore& store = scratch.store;
   heap.clear();
-  arena.clear();
+  store.prepare(id);
   SegmentClearance result;
+  const QuerySegment segment(a, b);
   const double pScale = std::max(maxAbs(a), maxAbs(b));
   // A surface point nearer than the clearance refutes it; the nearest seen is kept.
   bool violated = false;
   const auto consider = [&](Vec3 q, std::uint32_t patch, double u, double v) {
-    const double d = norm(q - nearestOnSegment(a, b, q));
+    const double d = norm(q - nearestOnSegment(segment, q));
     if (d < result.distance) {
       result.distance = d;
       result.patch = patch;
@@ -764,17 +932,17 @@ SegmentClearance segmentSearch(const std::vector<PatchTree>& trees, Vec3 a, Vec3
     }
     if (d < clearance) violated = true;
   };
-  const auto offer = [&](Cell cell) {
+  const auto offer = [&](Cell cell, unsigned fresh) {
     ++result.cells;
     const PatchTree& tree = trees[cell.patch];
-    const Vec3* net = cellNet(tree, cell, arena);
-    const Box box = cornersAndBox(tree, cell, net, consider);
+    const Vec3* net = cellNet(tree, cell, store);
+    const Box box = cornersAndBox(tree, cell, net, fresh, store, consider);
     const double allowance = cellAllowance(tree, cell.depth, pScale);
     const int m = tree.degreeU;
     const int n = tree.degreeV;
-    double lower = boxSegmentDistance(box, a, b);
+    double lower = boxSegmentDistance(box, segment);
     if (lower - allowance < clearance) {
-      lower = std::max(lower, separatingPlaneSegmentDistance(net, m, n, a, b));
+      lower = std::max(lower, separatingPlaneSegmentDistance(net, m, n, segment));
     }
     cell.lower = lower - allowance;
     if (cell.lower >= clearance) return;  // proven clear
@@ -782,7 +950,7 @@ SegmentClearance segmentSearch(const std::vector<PatchTree>& trees, Vec3 a, Vec3
     std::push_heap(heap.begin(), heap.end(), ByLowerBound{});
   };
   for (std::size_t i = 0; i < trees.size() && !violated; ++i) {
-    offer({0.0, static_cast<std::uint32_t>(i), 0, true, 0, 0.0, 0.0});
+    offer({0.0, static_cast<std::uint32_t>(i), 0, true, 0, 0, 0.0, 0.0}, 0b1111u);
   }
   while (!heap.empty() && !violated) {
     std::pop_heap(heap.begin(), heap.end(), ByLowerBound{});
@@ -793,7 +961,7 @@ SegmentClearance segmentSearch(const std::vector<PatchTree>& trees, Vec3 a, Vec3
       result.verdict = Clearance::undecided;
       return result;
     }
-    offerQuarters(cell, tree, arena, offer);
+    offerQuarters(cell, tree, store, offer);
   }
   result.verdict = violated ? Clearance::violated : Clearance::proven;
   return result;
@@ -956,6 +1124,9 @@ SurfaceDistance::SurfaceDistance(const Surface& surface, const DistanceOptions& 
                             options.treeDepth));
   }
   if (options.maxCells < 1) throw Error("surface distance: maxCells must be >= 1");
+  // Ids from 1 (0 marks an empty cell store); copies share theirs with the cells they hold.
+  static std::atomic<std::uint64_t> lastId{0};
+  id_ = lastId.fetch_add(1, std::memory_order_relaxed) + 1;
   tolerance_ = options.tolerance > 0.0 ? options.tolerance : 1e-9 * surfaceScale(surface_);
   // A surface collapsed to the origin has scale 0; any positive tolerance will do there.
   if (!(tolerance_ > 0.0)) tolerance_ = std::numeric_limits<double>::min();
@@ -974,13 +1145,13 @@ SurfaceDistance& SurfaceDistance::operator=(SurfaceDistance&&) noexcept = defaul
 ClosestPoint SurfaceDistance::closest(Vec3 p) const { return closest(p, kInfinity); }
 
 ClosestPoint SurfaceDistance::closest(Vec3 p, double cutoff) const {
-  return search(surface_, trees_, tolerance_, options_.maxCells, p, cutoff);
+  return search(surface_, trees_, id_, tolerance_, options_.maxCells, p, cutoff);
 }
 
 SegmentClearance SurfaceDistance::segmentClearance(Vec3 a, Vec3 b, double clearance,
                                                    std::size_t maxCells) const {
   if (maxCells < 1) throw Error("segment clearance: maxCells must be >= 1");
-  return segmentSearch(trees_, a, b, clearance, maxCells);
+  return segmentSearch(trees_, id_, a, b, clearance, maxCells);
 }
 
 double distanceToSurface(const Surface& surface, Vec3 p, const DistanceOptions& options) {

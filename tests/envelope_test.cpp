@@ -130,6 +130,76 @@ TEST(SegmentClearance, ProofsHoldAndViolationsAreReal) {
   EXPECT_EQ(undecided, 0u);
 }
 
+// The halved cells a thread keeps across queries (gouge.cpp's cell store) change nothing:
+// queries in small steps along a line (as the drop envelope's proofs along a pass), by one
+// engine and a copy of it (which shares its cells), then by two engines in turn (each
+// flushing the other's cells), give bit for bit what a fresh engine (an empty store) gives,
+// for segment clearances, proven and refuted, and for closest points.
+TEST(SegmentClearance, KeptCellsGiveTheSameBits) {
+  const Surface surfaces[2] = {exampleSurface("paper-1"), exampleSurface("paper-2")};
+  const SurfaceDistance engines[2] = {SurfaceDistance(surfaces[0]), SurfaceDistance(surfaces[1])};
+  const SurfaceDistance copy = engines[0];
+  struct Query {
+    int surface;
+    Vec3 a, b;
+    double clearance;
+  };
+  std::vector<Query> queries;
+  for (int k = 0; k < 2; ++k) {
+    const Surface& s = surfaces[k];
+    for (int i = 0; i < 300; ++i) {
+      const BezierPatch& patch = s.patches[static_cast<std::size_t>(i / 100) % s.patches.size()];
+      const double u = 0.2 + 0.006 * (i % 100);
+      Vec3 up = unitNormal(patch, u, 0.5);
+      if (up.z < 0.0) up = -up;
+      const Vec3 a = point(patch, u, 0.5) + 0.25 * up;  // touching, about
+      const double clearance = 0.25 + (i % 3 == 0 ? 1e-6 : -1e-5);  // refuted or proven
+      queries.push_back({k, a, a + Vec3{0.004, 0.001, 0.0}, clearance});
+      queries.push_back({k, a, a + Vec3{0.0, 0.0, 0.5}, clearance});  // straight up
+    }
+  }
+  struct Answer {
+    SegmentClearance segment;
+    ClosestPoint closest;
+  };
+  const auto ask = [&](const SurfaceDistance& engine, const Query& q) {
+    return Answer{engine.segmentClearance(q.a, q.b, q.clearance), engine.closest(q.b)};
+  };
+  std::vector<Answer> kept, turns, fresh;
+  for (std::size_t i = 0; i < queries.size(); ++i) {  // one surface after the other
+    const Query& q = queries[i];
+    kept.push_back(ask(q.surface == 0 && i % 2 == 1 ? copy : engines[q.surface], q));
+  }
+  for (std::size_t i = 0; i < queries.size() / 2; ++i) {  // the two surfaces in turn
+    for (const std::size_t j : {i, i + queries.size() / 2}) turns.push_back(ask(engines[queries[j].surface], queries[j]));
+  }
+  for (const Query& q : queries) fresh.push_back(ask(SurfaceDistance(surfaces[q.surface]), q));
+  const auto same = [](const Answer& x, const Answer& y, const std::string& where) {
+    EXPECT_EQ(x.segment.verdict, y.segment.verdict) << where;
+    EXPECT_EQ(x.segment.distance, y.segment.distance) << where;
+    EXPECT_EQ(x.segment.patch, y.segment.patch) << where;
+    EXPECT_EQ(x.segment.u, y.segment.u) << where;
+    EXPECT_EQ(x.segment.v, y.segment.v) << where;
+    EXPECT_EQ(x.segment.cells, y.segment.cells) << where;
+    EXPECT_EQ(x.closest.distance, y.closest.distance) << where;
+    EXPECT_EQ(x.closest.lowerBound, y.closest.lowerBound) << where;
+    EXPECT_EQ(x.closest.u, y.closest.u) << where;
+    EXPECT_EQ(x.closest.v, y.closest.v) << where;
+    EXPECT_EQ(x.closest.cells, y.closest.cells) << where;
+  };
+  std::size_t cells = 0, proven = 0;
+  for (std::size_t i = 0; i < queries.size(); ++i) {
+    same(kept[i], fresh[i], "query " + std::to_string(i));
+    const std::size_t half = queries.size() / 2;
+    same(turns[i], fresh[i % 2 == 0 ? i / 2 : half + i / 2], "in turn, query " + std::to_string(i));
+    cells += kept[i].segment.cells;
+    proven += kept[i].segment.verdict == Clearance::proven ? 1 : 0;
+  }
+  EXPECT_GT(cells, 20 * queries.size());  // deep enough to halve below the trees, often
+  EXPECT_GT(proven, queries.size() / 4);
+  EXPECT_LT(proven, queries.size());
+}
+
 // A segment lying exactly R from a plane, rolling along it: proven at R - 1e-9, refuted at
 // R + 1e-9 (the bound is second-order sharp, not a Lipschitz cone).
 TEST(SegmentClearance, SharpOnAPlane) {
