@@ -70,6 +70,16 @@ struct PlanOptions {
 // Rounds of rest finishing at most (each a simulation of the whole program more).
 constexpr int kRestRounds = 2;
 
+// report.json's `verification`: the simulated cut of the program in short.
+VerificationSummary verificationSummary(const SimulationReport& simulated, double stockAllowance) {
+  return VerificationSummary{simulated.design.spacing, simulated.heightErrorBound, stockAllowance,
+                             simulated.maxGouge, simulated.maxGougeAt, simulated.gougeArea,
+                             simulated.gougeTolerance, simulated.maxScallop, simulated.maxScallopAt,
+                             simulated.scallopP99, simulated.meanScallop, simulated.uncutArea,
+                             simulated.unreachableArea, simulated.maxUnreachableScallop,
+                             simulated.rapidsCutting, simulated.seconds};
+}
+
 // "; rest finishing: ..." when rest passes were added (what the strategies left, what it took).
 std::string restSummary(const PathsReport& report, Units units) {
   std::size_t passes = 0, targets = 0;
@@ -201,14 +211,7 @@ void runPlanMesh(const PlanOptions& options) {
   simulation.scallopHeight = height ? *height : radius - std::sqrt(radius * radius - 0.25 * spacing * spacing);
   simulation.stockAllowance = std::max(inch ? 0.01 : 0.25, 2.0 * simulation.scallopHeight);
   const SimulationReport simulated = verifyProgram(mesh, parseGcodeProgram(program, programName), simulation);
-  report.verification = VerificationSummary{simulated.design.spacing, simulated.heightErrorBound,
-                                            *simulation.stockAllowance, simulated.maxGouge,
-                                            simulated.maxGougeAt, simulated.gougeArea,
-                                            simulated.gougeTolerance, simulated.maxScallop,
-                                            simulated.maxScallopAt, simulated.scallopP99,
-                                            simulated.meanScallop, simulated.uncutArea,
-                                            simulated.unreachableArea, simulated.maxUnreachableScallop,
-                                            simulated.rapidsCutting, simulated.seconds};
+  report.verification = verificationSummary(simulated, *simulation.stockAllowance);
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   progress("writing the report");
   const fs::path dir = options.out;
@@ -334,14 +337,7 @@ void runPlan(const PlanOptions& options) {
   report.feedRate = gcodeOptions.feedRate;
   report.plungeFeedRate = gcodeOptions.plungeFeedRate;
   report.rapidRate = rapidRate;
-  report.verification = VerificationSummary{simulated.design.spacing, simulated.heightErrorBound,
-                                            *simulation.stockAllowance, simulated.maxGouge,
-                                            simulated.maxGougeAt, simulated.gougeArea,
-                                            simulated.gougeTolerance, simulated.maxScallop,
-                                            simulated.maxScallopAt, simulated.scallopP99,
-                                            simulated.meanScallop, simulated.uncutArea,
-                                            simulated.unreachableArea, simulated.maxUnreachableScallop,
-                                            simulated.rapidsCutting, simulated.seconds};
+  report.verification = verificationSummary(simulated, *simulation.stockAllowance);
   std::vector<OutputFile> outputs{
       {(dir / programName).string(), program},
       {(dir / "report.json").string(), pathsToJson(report, result.path)},

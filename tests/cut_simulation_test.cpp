@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "mesh_fixtures.hpp"
 #include "scallop/contour.hpp"
 #include "scallop/cut_simulation.hpp"
 #include "scallop/envelope.hpp"
@@ -1091,32 +1092,6 @@ TEST(CutSimulationReach, NothingIsUnreachableOnAPlaneOrAConvexDome) {
 namespace scallop {
 namespace {
 
-// A height field z = f(x, y) on an n x n grid of [0, 2]^2, each cell split along a random
-// diagonal.
-Mesh heightFieldMesh(std::size_t n, std::mt19937_64& rng) {
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  Mesh mesh;
-  mesh.units = Units::inch;
-  for (std::size_t j = 0; j <= n; ++j)
-    for (std::size_t i = 0; i <= n; ++i) {
-      const double x = 2.0 * static_cast<double>(i) / static_cast<double>(n);
-      const double y = 2.0 * static_cast<double>(j) / static_cast<double>(n);
-      mesh.vertices.push_back({x, y, 0.3 * std::sin(2.0 * x) * std::cos(3.0 * y) + 0.05 * unit(rng)});
-    }
-  const auto at = [n](std::size_t i, std::size_t j) { return static_cast<std::uint32_t>(j * (n + 1) + i); };
-  for (std::size_t j = 0; j < n; ++j)
-    for (std::size_t i = 0; i < n; ++i) {
-      if (unit(rng) < 0.5) {
-        mesh.triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
-        mesh.triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
-      } else {
-        mesh.triangles.push_back({at(i, j), at(i + 1, j), at(i, j + 1)});
-        mesh.triangles.push_back({at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)});
-      }
-    }
-  return mesh;
-}
-
 // The highest triangle over (x, y) by solving a + s (b - a) + t (c - a) = (x, y) in xy with
 // Cramer's rule (s, t >= 0, s + t <= 1, a hair of slack for points on an edge): -inf if none.
 double referenceMeshHeight(const Mesh& mesh, double x, double y) {
@@ -1138,7 +1113,7 @@ double referenceMeshHeight(const Mesh& mesh, double x, double y) {
 TEST(CutSimulationMesh, DesignHeightsAreTheHighestTriangleAgainstAReference) {
   std::mt19937_64 rng(7);
   for (int trial = 0; trial < 6; ++trial) {
-    const Mesh mesh = heightFieldMesh(6 + 3 * static_cast<std::size_t>(trial), rng);
+    const Mesh mesh = test::heightFieldMesh(6 + 3 * static_cast<std::size_t>(trial), rng, 0.05, true);
     SimulationOptions options;
     options.toolRadius = 0.25;
     options.scallopHeight = 0.001;

@@ -11,8 +11,10 @@
 #include <cstdio>
 #include <limits>
 #include <random>
+#include <utility>
 #include <vector>
 
+#include "mesh_fixtures.hpp"
 #include "scallop/cut_simulation.hpp"
 #include "scallop/error.hpp"
 #include "scallop/mesh.hpp"
@@ -51,23 +53,19 @@ double meshDistance(const Mesh& mesh, Vec3 p) {
   return best;
 }
 
-Mesh heightField(std::size_t n, std::mt19937_64& rng) {
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  Mesh mesh;
-  mesh.units = Units::inch;
-  for (std::size_t j = 0; j <= n; ++j)
-    for (std::size_t i = 0; i <= n; ++i) {
-      const double x = 2.0 * static_cast<double>(i) / static_cast<double>(n);
-      const double y = 2.0 * static_cast<double>(j) / static_cast<double>(n);
-      mesh.vertices.push_back({x, y, 0.3 * std::sin(2.0 * x) * std::cos(3.0 * y) + 0.04 * unit(rng)});
+// The largest scallop (along the normal) and vertical gouge over [0.3, 1.7]^2, away from the
+// edges of a 2 x 2 part.
+std::pair<double, double> innerFigures(const SimulationReport& report) {
+  double scallop = 0.0, gouge = 0.0;
+  for (std::size_t j = 0; j < report.stock.rows; ++j)
+    for (std::size_t i = 0; i < report.stock.columns; ++i) {
+      const Vec2 p = report.stock.point(i, j);
+      if (p.x < 0.3 || p.x > 1.7 || p.y < 0.3 || p.y > 1.7) continue;
+      const std::size_t k = j * report.stock.columns + i;
+      scallop = std::max(scallop, (report.stock.z[k] - report.design.z[k]) * report.designNormalZ[k]);
+      gouge = std::max(gouge, report.design.z[k] - report.stock.z[k]);
     }
-  const auto at = [n](std::size_t i, std::size_t j) { return static_cast<std::uint32_t>(j * (n + 1) + i); };
-  for (std::size_t j = 0; j < n; ++j)
-    for (std::size_t i = 0; i < n; ++i) {
-      mesh.triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
-      mesh.triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
-    }
-  return mesh;
+  return {scallop, gouge};
 }
 
 // Every move sampled at its ends and three points between: no centre nearer than R - eps by
@@ -76,7 +74,7 @@ Mesh heightField(std::size_t n, std::mt19937_64& rng) {
 TEST(MeshRaster, RandomHeightFieldsAreCutGougeFreeByBruteForce) {
   std::mt19937_64 rng(11);
   for (int trial = 0; trial < 3; ++trial) {
-    const Mesh mesh = heightField(8 + 4 * static_cast<std::size_t>(trial), rng);
+    const Mesh mesh = test::heightFieldMesh(8 + 4 * static_cast<std::size_t>(trial), rng, 0.04, false);
     const double radius = 0.15 + 0.1 * trial;
     const MeshDropCutter cutter(mesh, radius);
     MeshRasterOptions options;
@@ -128,15 +126,7 @@ TEST(MeshRaster, AnInclinedPlaneLeavesTheClosedFormCusp) {
   const double cosPhi = 1.0 / std::sqrt(1.25);
   const double l = options.spacing / cosPhi;
   const double cusp = radius - std::sqrt(radius * radius - 0.25 * l * l);
-  double inner = 0.0, innerGouge = 0.0;
-  for (std::size_t j = 0; j < report.stock.rows; ++j)
-    for (std::size_t i = 0; i < report.stock.columns; ++i) {
-      const Vec2 p = report.stock.point(i, j);
-      if (p.x < 0.3 || p.x > 1.7 || p.y < 0.3 || p.y > 1.7) continue;
-      const std::size_t k = j * report.stock.columns + i;
-      inner = std::max(inner, (report.stock.z[k] - report.design.z[k]) * report.designNormalZ[k]);
-      innerGouge = std::max(innerGouge, report.design.z[k] - report.stock.z[k]);
-    }
+  const auto [inner, innerGouge] = innerFigures(report);
   std::printf("[          ] spacing %.6f, cusp %.6f (flat %.6f), simulated %.6f, bound %.3g\n", options.spacing, cusp,
               height, inner, report.heightErrorBound);
   EXPECT_LE(inner, cusp + 1e-9);
@@ -166,14 +156,7 @@ TEST(MeshRaster, AdaptiveStepsHoldTheCuspOnASlopeToH) {
   simulation.stockAllowance = 0.02;
   const SimulationReport report = simulateCut(mesh, sweptMoves(paths.path), simulation);
   const double cosPhi = 1.0 / std::sqrt(1.25);
-  double inner = 0.0;
-  for (std::size_t j = 0; j < report.stock.rows; ++j)
-    for (std::size_t i = 0; i < report.stock.columns; ++i) {
-      const Vec2 p = report.stock.point(i, j);
-      if (p.x < 0.3 || p.x > 1.7 || p.y < 0.3 || p.y > 1.7) continue;
-      const std::size_t k = j * report.stock.columns + i;
-      inner = std::max(inner, (report.stock.z[k] - report.design.z[k]) * report.designNormalZ[k]);
-    }
+  const double inner = innerFigures(report).first;
   std::printf("[          ] %zu lines, step %.6f (flat %.6f), simulated cusp %.6f (H %.6f)\n", paths.lines,
               paths.minSpacing, options.spacing, inner, height);
   EXPECT_LE(inner, height + 1e-9);
