@@ -105,14 +105,20 @@ TEST(MeshRaster, RandomHeightFieldsAreCutGougeFreeByBruteForce) {
   }
 }
 
-// An inclined plane z = y / 2 as two triangles, the feed along x: neighbouring lines' balls
-// stand L = Delta / cos(phi) apart along the slope, so the cusp is R - sqrt(R^2 - L^2 / 4);
-// the simulated cut reads it between the first and last lines within the grid's bound.
-TEST(MeshRaster, AnInclinedPlaneLeavesTheClosedFormCusp) {
+// The plane z = y / 2 over [0, 2]^2 as two triangles (inches).
+Mesh inclinedPlane() {
   Mesh mesh;
   mesh.units = Units::inch;
   mesh.vertices = {{0.0, 0.0, 0.0}, {2.0, 0.0, 0.0}, {0.0, 2.0, 1.0}, {2.0, 2.0, 1.0}};
   mesh.triangles = {{0, 1, 3}, {0, 3, 2}};
+  return mesh;
+}
+
+// An inclined plane z = y / 2 as two triangles, the feed along x: neighbouring lines' balls
+// stand L = Delta / cos(phi) apart along the slope, so the cusp is R - sqrt(R^2 - L^2 / 4);
+// the simulated cut reads it between the first and last lines within the grid's bound.
+TEST(MeshRaster, AnInclinedPlaneLeavesTheClosedFormCusp) {
+  const Mesh mesh = inclinedPlane();
   const double radius = 0.25, height = 0.002;
   const MeshDropCutter cutter(mesh, radius);
   MeshRasterOptions options;
@@ -138,10 +144,7 @@ TEST(MeshRaster, AnInclinedPlaneLeavesTheClosedFormCusp) {
 // The same plane with the cusp-adaptive steps for H: w = Delta sqrt(1 + s_e^2) = w_H on it,
 // so the simulated cusp is H (within the grid's bound), never above.
 TEST(MeshRaster, AdaptiveStepsHoldTheCuspOnASlopeToH) {
-  Mesh mesh;
-  mesh.units = Units::inch;
-  mesh.vertices = {{0.0, 0.0, 0.0}, {2.0, 0.0, 0.0}, {0.0, 2.0, 1.0}, {2.0, 2.0, 1.0}};
-  mesh.triangles = {{0, 1, 3}, {0, 3, 2}};
+  const Mesh mesh = inclinedPlane();
   const double radius = 0.25, height = 0.002;
   const MeshDropCutter cutter(mesh, radius);
   MeshRasterOptions options;
@@ -162,7 +165,7 @@ TEST(MeshRaster, AdaptiveStepsHoldTheCuspOnASlopeToH) {
   EXPECT_LE(inner, height + 1e-9);
   EXPECT_GE(inner, height - report.heightErrorBound / cosPhi);
   // A horizontal plane keeps the flat spacing.
-  Mesh flat = mesh;
+  Mesh flat = inclinedPlane();
   for (Vec3& v : flat.vertices) v.z = 0.0;
   const MeshDropCutter flatCutter(flat, radius);
   EXPECT_NEAR(meshRasterPaths(flatCutter, flat, options).minSpacing, options.spacing, 1e-12);
