@@ -70,6 +70,24 @@ struct PlanOptions {
 // Rounds of rest finishing at most (each a simulation of the whole program more).
 constexpr int kRestRounds = 2;
 
+// The cusp between balls of radius R on neighbouring passes `spacing` apart on a flat surface:
+// the scallop height a plan given --spacing is simulated against. Refused from 2 R up, where
+// the balls do not meet and nothing bounds what is left between passes.
+double flatCusp(double radius, double spacing) {
+  if (!(spacing < 2.0 * radius))
+    throw Error(fmt::format("the spacing {} is not below the ball's diameter {}: neighbouring passes would leave "
+                            "uncut ridges of any height (give a spacing below 2 R, or --scallop-height)",
+                            spacing, 2.0 * radius));
+  return radius - std::sqrt(radius * radius - 0.25 * spacing * spacing);
+}
+
+// The largest |coordinate| of a mesh's vertices (as surfaceScale is a surface's).
+double meshScale(const Mesh& mesh) {
+  double scale = 0.0;
+  for (const Vec3& v : mesh.vertices) scale = std::max({scale, std::abs(v.x), std::abs(v.y), std::abs(v.z)});
+  return scale;
+}
+
 // report.json's `verification`: the simulated cut of the program in short.
 VerificationSummary verificationSummary(const SimulationReport& simulated, double stockAllowance) {
   return VerificationSummary{simulated.design.spacing, simulated.heightErrorBound, stockAllowance,
@@ -122,10 +140,16 @@ void runPlanMesh(const PlanOptions& options) {
   const double radius = options.toolRadius.empty()
                             ? (inch ? 0.25 : 6.0)
                             : parsePositive(options.toolRadius, "tool radius", "a positive length");
+  // A ball a thousand times the size of the part is a typo, not a tool (as for surfaces).
+  if (radius > 1e3 * std::max(meshScale(mesh), 1e-300))
+    throw Error(fmt::format("{}: the tool radius {} is more than 1000 times the mesh's size (largest |coordinate| {} "
+                            "{}); check the units (--units)",
+                            path, radius, meshScale(mesh), unitsName(mesh.units)));
   std::optional<double> height;
   double spacing = 0.0;
   if (!options.spacing.empty()) {
     spacing = parsePositive(options.spacing, "spacing", "a positive length");
+    flatCusp(radius, spacing);  // refused early from 2 R up
   } else {
     height = options.scallopHeight.empty() ? (inch ? 0.001 : 0.025)
                                            : parsePositive(options.scallopHeight, "scallop height", "a positive length");
@@ -208,7 +232,7 @@ void runPlanMesh(const PlanOptions& options) {
   progress("simulating the cut of the program on the mesh (scallop verify)");
   SimulationOptions simulation;
   simulation.toolRadius = radius;
-  simulation.scallopHeight = height ? *height : radius - std::sqrt(radius * radius - 0.25 * spacing * spacing);
+  simulation.scallopHeight = height ? *height : flatCusp(radius, spacing);
   simulation.stockAllowance = std::max(inch ? 0.01 : 0.25, 2.0 * simulation.scallopHeight);
   const SimulationReport simulated = verifyProgram(mesh, parseGcodeProgram(program, programName), simulation);
   report.verification = verificationSummary(simulated, *simulation.stockAllowance);
@@ -259,6 +283,7 @@ void runPlan(const PlanOptions& options) {
                        : parsePositive(options.toolRadius, "tool radius", "a positive length");
   if (!options.spacing.empty()) {
     job.spacing = parsePositive(options.spacing, "spacing", "a positive length");
+    flatCusp(job.toolRadius, *job.spacing);  // refused early from 2 R up
   } else {
     job.scallopHeight = options.scallopHeight.empty()
                             ? (inch ? 0.001 : 0.025)
@@ -288,10 +313,7 @@ void runPlan(const PlanOptions& options) {
   // flat-surface one of the spacing given).
   SimulationOptions simulation;
   simulation.toolRadius = job.toolRadius;
-  simulation.scallopHeight = job.scallopHeight
-                                 ? *job.scallopHeight
-                                 : job.toolRadius - std::sqrt(job.toolRadius * job.toolRadius -
-                                                              0.25 * report.spacing * report.spacing);
+  simulation.scallopHeight = job.scallopHeight ? *job.scallopHeight : flatCusp(job.toolRadius, report.spacing);
   simulation.stockAllowance = std::max(report.linking ? 0.5 * report.linking->clearance : (inch ? 0.01 : 0.25),
                                        2.0 * simulation.scallopHeight);
   GcodeOptions gcodeOptions;

@@ -598,9 +598,11 @@ std::size_t sweepMoves(const std::vector<SweptMove>& moves, double toolRadius, H
 
 namespace {
 
-// Makes, per thread, a test of whether the ball can reach a surface point q left above H
-// (true: it cannot; see the contract's Reach); none: no classification.
-using ReachTestFactory = std::function<std::function<bool(Vec3)>()>;
+// Whether the ball cannot reach a surface point q left above H (see the contract's Reach).
+using ReachTest = std::function<bool(Vec3)>;
+// Called once, only when some point is left above H (its engine is built then, off the path
+// of the simulations that leave none): makes a ReachTest per thread. None: no classification.
+using ReachPreparation = std::function<std::function<ReachTest()>()>;
 
 // A report's figures before the design: units, tool, grid, tolerances, the stock's top.
 SimulationReport reportFor(Units units, HeightGrid grid, double highest, const SimulationOptions& options) {
@@ -618,7 +620,7 @@ SimulationReport reportFor(Units units, HeightGrid grid, double highest, const S
 // The sweep and the comparison on a report whose design grid, normals, stock top and
 // tolerances are set.
 void sweepAndCompare(SimulationReport& report, const std::vector<SweptMove>& moves, const SimulationOptions& options,
-                     const ReachTestFactory& reachTest, std::chrono::steady_clock::time_point start);
+                     const ReachPreparation& prepareReach, std::chrono::steady_clock::time_point start);
 
 }  // namespace
 
@@ -631,15 +633,16 @@ SimulationReport simulateCut(const Surface& surface, const std::vector<SweptMove
   SimulationReport report = reportFor(surface.units, simulationGrid(surface, options), top, options);
   designHeights(surface, report.design, &report.designNormalZ);
   report.designSeconds = secondsSince(start);
-  std::shared_ptr<const SurfaceDistance> distance;
-  if (options.classifyReach) distance = std::make_shared<const SurfaceDistance>(surface);
   const double radius = options.toolRadius, height = options.scallopHeight;
   sweepAndCompare(report, moves, options,
-                  [&]() -> std::function<bool(Vec3)> {
-                    auto cutter = std::make_shared<DropCutter>(*distance, radius);
-                    return [distance, cutter, radius, height](Vec3 q) {
-                      const ReachWitness witness = reachWitness(*distance, *cutter, q, radius);
-                      return witness.centre && witness.gap > height;
+                  [&]() -> std::function<ReachTest()> {
+                    const auto distance = std::make_shared<const SurfaceDistance>(surface);
+                    return [distance, radius, height]() -> ReachTest {
+                      auto cutter = std::make_shared<DropCutter>(*distance, radius);
+                      return [distance, cutter, radius, height](Vec3 q) {
+                        const ReachWitness witness = reachWitness(*distance, *cutter, q, radius);
+                        return witness.centre && witness.gap > height;
+                      };
                     };
                   },
                   start);
@@ -660,7 +663,7 @@ SimulationReport simulateCut(const Mesh& mesh, const std::vector<SweptMove>& mov
 namespace {
 
 void sweepAndCompare(SimulationReport& report, const std::vector<SweptMove>& moves, const SimulationOptions& options,
-                     const ReachTestFactory& reachTest, std::chrono::steady_clock::time_point start) {
+                     const ReachPreparation& prepareReach, std::chrono::steady_clock::time_point start) {
   const auto sweepStart = std::chrono::steady_clock::now();
   report.stock = report.design;
   const double evaluations = sweepEvaluations(moves, options.toolRadius, report.stock);
@@ -712,13 +715,14 @@ void sweepAndCompare(SimulationReport& report, const std::vector<SweptMove>& mov
   }
   // Which of the points left above H the ball can reach at all (see the contract).
   report.unreachable.assign(design.z.size(), 0);
-  if (options.classifyReach && reachTest && !uncut.empty()) {
+  if (options.classifyReach && prepareReach && !uncut.empty()) {
     const auto reachStart = std::chrono::steady_clock::now();
+    const std::function<ReachTest()> reachTest = prepareReach();
     const std::size_t checks = std::min(uncut.size(), options.maxReachChecks);
     report.reachChecks = checks;
     report.reachBudgetExhausted = checks < uncut.size();
     const auto classify = [&](std::size_t from, std::size_t to) {
-      const std::function<bool(Vec3)> beyondReach = reachTest();
+      const ReachTest beyondReach = reachTest();
       for (std::size_t k = from; k < to; ++k) {
         const std::size_t index = uncut[k];
         const Vec2 p = design.point(index % design.columns, index / design.columns);

@@ -194,14 +194,17 @@ MeshRasterPaths meshRasterPaths(const MeshDropCutter& cutter, const Mesh& mesh, 
   drop.sagTolerance = options.sagTolerance;
   out.path.units = mesh.units;
   out.path.toolRadius = radius;
-  ToolPass pass;
-  pass.retractBefore = true;
-  bool started = false;
-  const auto append = [&](const DropLine& line, bool backwards, bool skipFirst) {
+  // Every drop line's counts, the lines left out and the links included.
+  const auto tally = [&](const DropLine& line) {
     out.drops += line.drops;
     out.proofs += line.proofs;
     out.unprovenMoves += line.unprovenMoves;
     out.eps = line.eps;
+  };
+  ToolPass pass;
+  pass.retractBefore = true;
+  bool started = false;
+  const auto append = [&](const DropLine& line, bool backwards, bool skipFirst) {
     const std::size_t n = line.vertices.size();
     for (std::size_t i = skipFirst ? 1 : 0; i < n; ++i) {
       const Vec3 c = line.vertices[backwards ? n - 1 - i : i].centre;
@@ -218,16 +221,18 @@ MeshRasterPaths meshRasterPaths(const MeshDropCutter& cutter, const Mesh& mesh, 
   std::vector<double> kept;
   for (const double b : offsets) {
     DropLine line = cutter.dropLine(Vec2{b * across.x, b * across.y}, along, t0, t1, drop);
+    tally(line);
     const bool touches = std::any_of(line.vertices.begin(), line.vertices.end(), [](const DropLineVertex& v) {
       return v.contact.feature != MeshFeature::none;
     });
-    out.drops += line.drops;
-    out.proofs += line.proofs;
     if (!touches) continue;
     dropLines.push_back(std::move(line));
     kept.push_back(b);
   }
   const std::size_t lines = kept.size();
+  // Every line crosses the mesh's extent: one that touches it exists unless the cutter was
+  // built from another mesh.
+  if (lines == 0) throw Error("mesh raster: no line touches the mesh (is the cutter built from it?)");
   out.lines = lines;
   out.lineOffsets = kept;
   out.minSpacing = lines > 2 ? std::numeric_limits<double>::infinity() : (lines == 2 ? kept[1] - kept[0] : 0.0);
@@ -239,12 +244,11 @@ MeshRasterPaths meshRasterPaths(const MeshDropCutter& cutter, const Mesh& mesh, 
       // vertex is the previous line's last (the same drop point), its last this line's first.
       const double t = backwards ? t1 : t0;
       DropLine link = cutter.dropLine(Vec2{t * along.x, t * along.y}, across, kept[k - 1], kept[k], drop);
+      tally(link);
       if (!link.vertices.empty()) link.vertices.pop_back();
       append(link, false, true);
     }
-    DropLine& line = dropLines[k];
-    line.drops = line.proofs = 0;  // counted above
-    append(line, backwards, false);
+    append(dropLines[k], backwards, false);
   }
   Vec3 at = pass.start;
   for (const ToolMove& move : pass.moves) {

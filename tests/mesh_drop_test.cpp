@@ -36,6 +36,7 @@
 #include <string>
 #include <vector>
 
+#include "mesh_fixtures.hpp"
 #include "scallop/error.hpp"
 #include "scallop/mesh.hpp"
 
@@ -156,22 +157,7 @@ double meshSize(const Mesh& m) {
 // random diagonal.
 Mesh heightfield(std::mt19937_64& rng, int n, double amp) {
   std::uniform_real_distribution<double> h(0.0, amp);
-  std::bernoulli_distribution coin(0.5);
-  Mesh m;
-  for (int j = 0; j <= n; ++j)
-    for (int i = 0; i <= n; ++i) m.vertices.push_back({double(i), double(j), h(rng)});
-  const auto id = [&](int i, int j) { return static_cast<std::uint32_t>(j * (n + 1) + i); };
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) {
-      if (coin(rng)) {
-        m.triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-        m.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
-      } else {
-        m.triangles.push_back({id(i, j), id(i + 1, j), id(i, j + 1)});
-        m.triangles.push_back({id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
-      }
-    }
-  return m;
+  return scallop::test::gridMesh(static_cast<std::size_t>(n), double(n), [&](double, double) { return h(rng); }, rng, true);
 }
 
 // A soup of n triangles in [0, 4]^2 x [0, 2]: general ones, vertical ones (the three

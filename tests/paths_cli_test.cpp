@@ -217,6 +217,18 @@ TEST_F(PathsCli, PlanCutsAnStlMeshByRaster) {
     EXPECT_NE(refused.err.find("not for a mesh"), std::string::npos) << refused.err;
     EXPECT_FALSE(fs::exists(workDir_ / "x"));
   }
+  // A spacing the balls cannot bridge, and a ball in the wrong units: one line, nothing written
+  // (the same spacing for a surface too).
+  for (const char* arguments : {"plan paper1.stl --units in --tool-radius 0.25 --spacing 0.6 --out x",
+                                "plan paper1.stl --units in --tool-radius 6000 --out x",
+                                "plan --example paper-1 --tool-radius 0.25 --spacing 0.6 --out x"}) {
+    const RunResult refused = run(arguments);
+    EXPECT_EQ(refused.exitCode, 1) << arguments;
+    EXPECT_EQ(std::count(refused.err.begin(), refused.err.end(), '\n'), 1) << refused.err;
+    EXPECT_TRUE(refused.err.find("diameter") != std::string::npos || refused.err.find("1000 times") != std::string::npos)
+        << refused.err;
+    EXPECT_FALSE(fs::exists(workDir_ / "x"));
+  }
 }
 
 // The main job's G-code, for both strategies and both dialects, goes through LinuxCNC's own
