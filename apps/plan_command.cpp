@@ -234,6 +234,9 @@ void runPlanMesh(const PlanOptions& options) {
   simulation.toolRadius = radius;
   simulation.scallopHeight = height ? *height : flatCusp(radius, spacing);
   simulation.stockAllowance = std::max(inch ? 0.01 : 0.25, 2.0 * simulation.scallopHeight);
+  // The finishing stock is the surface raised by the allowance everywhere: a flat top at the
+  // part's highest point would clip it there (a flat part would show no scallop at all).
+  simulation.stockTop = top + *simulation.stockAllowance;
   const SimulationReport simulated = verifyProgram(mesh, parseGcodeProgram(program, programName), simulation);
   report.verification = verificationSummary(simulated, *simulation.stockAllowance);
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -316,6 +319,12 @@ void runPlan(const PlanOptions& options) {
   simulation.scallopHeight = job.scallopHeight ? *job.scallopHeight : flatCusp(job.toolRadius, report.spacing);
   simulation.stockAllowance = std::max(report.linking ? 0.5 * report.linking->clearance : (inch ? 0.01 : 0.25),
                                        2.0 * simulation.scallopHeight);
+  // The finishing stock is the surface raised by the allowance everywhere: a flat top at the
+  // part's highest point would clip it there (a flat part would show no scallop at all).
+  double top = -std::numeric_limits<double>::infinity();
+  for (const BezierPatch& patch : surface.patches)
+    for (const Vec3& c : patch.control) top = std::max(top, c.z);
+  simulation.stockTop = top + *simulation.stockAllowance;
   GcodeOptions gcodeOptions;
   std::string program;
   const auto writeAndSimulate = [&] {
