@@ -174,6 +174,25 @@ void runPlanMesh(const PlanOptions& options) {
   if (height) raster.sagTolerance = *height / 4.0;
   // With H, the steps between lines adapt to the facets' slopes (mesh_raster.hpp).
   if (height) raster.scallopHeight = *height;
+  // Off the part the ball runs R above the lowest point seen from above (the simulation's
+  // design, exact at its grid points), never beside the part below what it shows.
+  SimulationOptions simulation;
+  simulation.toolRadius = radius;
+  simulation.scallopHeight = height ? *height : flatCusp(radius, spacing);
+  simulation.stockAllowance = std::max(inch ? 0.01 : 0.25, 2.0 * simulation.scallopHeight);
+  double top = -std::numeric_limits<double>::infinity();
+  for (const Vec3& v : mesh.vertices) top = std::max(top, v.z);
+  // The finishing stock is the surface raised by the allowance everywhere: a flat top at the
+  // part's highest point would clip it there (a flat part would show no scallop at all).
+  simulation.stockTop = top + *simulation.stockAllowance;
+  {
+    HeightGrid visible = simulationGrid(mesh, simulation);
+    designHeights(mesh, visible);
+    double lowest = std::numeric_limits<double>::infinity();
+    for (const double z : visible.z)
+      if (z != -std::numeric_limits<double>::infinity()) lowest = std::min(lowest, z);
+    if (std::isfinite(lowest)) raster.floor = lowest + radius;
+  }
   const MeshRasterPaths paths = [&] {
     try {
       return meshRasterPaths(cutter, solid, raster);
@@ -221,8 +240,6 @@ void runPlanMesh(const PlanOptions& options) {
   const GcodeDialect dialect = gcodeDialect(options.dialect);
   const std::string title = fmt::format("scallop plan raster {}", path);
   const std::string programName = dialect == GcodeDialect::grbl ? "toolpath.gcode" : "toolpath.ngc";
-  double top = -std::numeric_limits<double>::infinity();
-  for (const Vec3& v : mesh.vertices) top = std::max(top, v.z);
   const GcodeOptions gcodeOptions = defaultGcodeOptions(mesh.units, top, paths.path, dialect, title);
   const std::string program = gcodeProgram(paths.path, gcodeOptions);
   report.motion = gcodeMotion(paths.path, gcodeOptions, rapidRate);
@@ -230,13 +247,6 @@ void runPlanMesh(const PlanOptions& options) {
   report.plungeFeedRate = gcodeOptions.plungeFeedRate;
   report.rapidRate = rapidRate;
   progress("simulating the cut of the program on the mesh (scallop verify)");
-  SimulationOptions simulation;
-  simulation.toolRadius = radius;
-  simulation.scallopHeight = height ? *height : flatCusp(radius, spacing);
-  simulation.stockAllowance = std::max(inch ? 0.01 : 0.25, 2.0 * simulation.scallopHeight);
-  // The finishing stock is the surface raised by the allowance everywhere: a flat top at the
-  // part's highest point would clip it there (a flat part would show no scallop at all).
-  simulation.stockTop = top + *simulation.stockAllowance;
   const SimulationReport simulated = verifyProgram(mesh, parseGcodeProgram(program, programName), simulation);
   report.verification = verificationSummary(simulated, *simulation.stockAllowance);
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

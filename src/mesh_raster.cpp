@@ -192,6 +192,7 @@ MeshRasterPaths meshRasterPaths(const MeshDropCutter& cutter, const Mesh& mesh, 
   DropLineOptions drop;
   drop.eps = options.eps;
   drop.sagTolerance = options.sagTolerance;
+  drop.floor = options.floor;
   out.path.units = mesh.units;
   out.path.toolRadius = radius;
   // Every drop line's counts, the lines left out and the links included.

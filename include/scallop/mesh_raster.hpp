@@ -31,7 +31,7 @@
 // Passes: one continuous pass, zigzag: line k forwards when k is even, backwards when odd;
 //         each line is dropLine's envelope (exact drop heights at its vertices, every move
 //         proven to keep the centre at least R - eps from the mesh; off the part the ball runs
-//         at the floor, the mesh's lowest z + R); consecutive lines are joined at their common
+//         at the floor (MeshRasterOptions::floor)); consecutive lines are joined at their common
 //         end by the drop line across (along e from b_k to b_k+1 at that end), proven the
 //         same way: no move of the path cuts deeper than eps.
 // Spacing: with a constant Delta the cusp on a horizontal facet is R - sqrt(R^2 - Delta^2 / 4)
@@ -46,6 +46,7 @@
 // Deterministic.
 
 #include <cstddef>
+#include <limits>
 #include <vector>
 
 #include "scallop/mesh.hpp"
@@ -59,6 +60,12 @@ struct MeshRasterOptions {
   double angleRad = 0.0;  ///< feed direction from +x (radians)
   double eps = 0.0;       ///< depth proven; 0: 1e-6 of the mesh's size (dropLine's default)
   double sagTolerance = 0.0;  ///< dropLine's midpoint check; 0: its default (eps)
+  /// The centre's height where nothing lies within R (dropLine's floor); NaN: the mesh's
+  /// lowest z + R. A plan passes the lowest point visible from above + R: a part whose
+  /// hidden underside reaches lower (a sphere through a plate) would otherwise have its balls
+  /// run beside its walls below their tops, grazing them within eps, which a z-map reads as
+  /// its columns cut down to the ball's equator.
+  double floor = std::numeric_limits<double>::quiet_NaN();
   /// H > 0: cusp-adaptive steps, at most `spacing` (see the contract); 0: constant spacing.
   double scallopHeight = 0.0;
   std::size_t maxLines = 100'000;  ///< budget
