@@ -231,6 +231,36 @@ TEST_F(PathsCli, PlanCutsAnStlMeshByRaster) {
   }
 }
 
+// A plate at z = 0 over a hidden pyramid reaching down to z = -20 (mm), as OpenCAMLib's
+// sphere.stl is a sphere through a plate: off the part the balls run R above the lowest point
+// seen from above (the plate), not beside the plate below it, where grazing its corner within
+// eps read as a 20 mm gouge in the simulated cut.
+TEST_F(PathsCli, PlanOfAPlateOverAHiddenUndersideRunsAboveThePlate) {
+  const auto facet = [](const char* a, const char* b, const char* c) {
+    return fmt::format("facet normal 0 0 0\nouter loop\nvertex {}\nvertex {}\nvertex {}\nendloop\nendfacet\n", a, b, c);
+  };
+  const std::string stl = "solid plate\n" + facet("0 0 0", "10 0 0", "10 10 0") + facet("0 0 0", "10 10 0", "0 10 0") +
+                          facet("0 0 0", "10 0 0", "5 5 -20") + facet("10 0 0", "10 10 0", "5 5 -20") +
+                          facet("10 10 0", "0 10 0", "5 5 -20") + facet("0 10 0", "0 0 0", "5 5 -20") +
+                          "endsolid plate\n";
+  write("plate.stl", stl);
+  const RunResult result = run("plan plate.stl --tool-radius 1 --scallop-height 0.01 --quiet --out p");
+  ASSERT_EQ(result.exitCode, 0) << result.err;
+  const auto report = nlohmann::json::parse(readFile(workDir_ / "p" / "report.json"));
+  const auto& v = report["verification"];
+  EXPECT_LE(v["max_gouge"].get<double>(), v["gouge_tolerance"].get<double>());
+  EXPECT_LE(v["max_scallop"].get<double>(), 0.01);
+  // The ball never goes below the plate's top + R (a tip at or above 0).
+  const std::string gcode = readFile(workDir_ / "p" / "toolpath.ngc");
+  std::stringstream lines(gcode);
+  double lowest = 1e300;
+  for (std::string line; std::getline(lines, line);) {
+    const auto z = line.find(" Z");
+    if (line.rfind("G1", 0) == 0 && z != std::string::npos) lowest = std::min(lowest, std::stod(line.substr(z + 2)));
+  }
+  EXPECT_GE(lowest, -1e-4);
+}
+
 // The main job's G-code, for both strategies and both dialects, goes through LinuxCNC's own
 // interpreter without a single complaint, and its cutting moves end where the report's passes
 // say (tips = centres - R).
