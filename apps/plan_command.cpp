@@ -165,7 +165,17 @@ void runPlanMesh(const PlanOptions& options) {
                        mesh.triangles.size(), stl.format == StlFormat::binary ? "binary" : "ASCII", spacing,
                        unitsName(mesh.units), radius, unitsName(mesh.units)));
   // The proofs see the mesh as the top of a solid (its open edges walled down to its bottom).
-  const Mesh solid = meshWithSkirt(mesh);
+  // The walls stand 4 eps outside the edges (eps: the drop lines' 1e-6 of the mesh's size).
+  double diagonal = 0.0;
+  {
+    Vec3 lo = mesh.vertices.front(), hi = lo;
+    for (const Vec3& v : mesh.vertices) {
+      lo = {std::min(lo.x, v.x), std::min(lo.y, v.y), std::min(lo.z, v.z)};
+      hi = {std::max(hi.x, v.x), std::max(hi.y, v.y), std::max(hi.z, v.z)};
+    }
+    diagonal = norm(hi - lo);
+  }
+  const Mesh solid = meshWithSkirt(mesh, 4e-6 * diagonal);
   const MeshDropCutter cutter(solid, radius);
   MeshRasterOptions raster;
   raster.spacing = spacing;

@@ -14,30 +14,40 @@
 
 namespace scallop {
 
-Mesh meshWithSkirt(const Mesh& mesh) {
+Mesh meshWithSkirt(const Mesh& mesh, double offset) {
+  if (!(offset >= 0.0) || !std::isfinite(offset))
+    throw Error(fmt::format("mesh skirt: the offset must be >= 0 and finite, got {}", offset));
   Mesh out = mesh;
   if (mesh.vertices.empty()) return out;
   double bottom = std::numeric_limits<double>::infinity();
   for (const Vec3& v : mesh.vertices) bottom = std::min(bottom, v.z);
-  std::map<std::pair<std::uint32_t, std::uint32_t>, int> uses;
+  // Each edge's uses, and the far vertex of its (last) triangle: the side of the material.
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::pair<int, std::uint32_t>> uses;
   for (const auto& t : mesh.triangles)
-    for (int k = 0; k < 3; ++k) {
-      const std::uint32_t u = t[static_cast<std::size_t>(k)], v = t[static_cast<std::size_t>((k + 1) % 3)];
-      ++uses[{std::min(u, v), std::max(u, v)}];
+    for (std::size_t k = 0; k < 3; ++k) {
+      const std::uint32_t u = t[k], v = t[(k + 1) % 3];
+      auto& use = uses[{std::min(u, v), std::max(u, v)}];
+      ++use.first;
+      use.second = t[(k + 2) % 3];
     }
-  std::map<std::uint32_t, std::uint32_t> below;  // a vertex's foot at the bottom
-  const auto foot = [&](std::uint32_t v) {
-    const auto [at, fresh] = below.try_emplace(v, static_cast<std::uint32_t>(out.vertices.size()));
-    if (fresh) out.vertices.push_back({mesh.vertices[v].x, mesh.vertices[v].y, bottom});
-    return at->second;
+  const auto add = [&](Vec3 p) {
+    out.vertices.push_back(p);
+    return static_cast<std::uint32_t>(out.vertices.size() - 1);
   };
-  for (const auto& [edge, count] : uses) {
-    if (count != 1) continue;
-    const auto [a, b] = edge;
-    if (mesh.vertices[a].z <= bottom && mesh.vertices[b].z <= bottom) continue;  // on the bottom: no wall
-    const std::uint32_t fa = foot(a), fb = foot(b);
-    out.triangles.push_back({a, b, fb});
-    out.triangles.push_back({a, fb, fa});
+  for (const auto& [edge, use] : uses) {
+    if (use.first != 1) continue;
+    const Vec3 a = mesh.vertices[edge.first], b = mesh.vertices[edge.second], far = mesh.vertices[use.second];
+    if (a.z <= bottom && b.z <= bottom) continue;  // on the bottom: no wall
+    // Outwards in xy: perpendicular to the edge, away from its triangle.
+    Vec3 away{a.y - b.y, b.x - a.x, 0.0};
+    const double length = norm(away);
+    away = length > 0.0 ? (1.0 / length) * away : Vec3{};
+    if ((far.x - a.x) * away.x + (far.y - a.y) * away.y > 0.0) away = -away;
+    const Vec3 shift = offset * away;
+    const std::uint32_t ta = add(a + shift), tb = add(b + shift);
+    const std::uint32_t fa = add({a.x + shift.x, a.y + shift.y, bottom}), fb = add({b.x + shift.x, b.y + shift.y, bottom});
+    out.triangles.push_back({ta, tb, fb});
+    out.triangles.push_back({ta, fb, fa});
   }
   return out;
 }

@@ -185,6 +185,17 @@ TEST(MeshRaster, TheSkirtWallsTheOpenEdgesOfASheet) {
     const Vec3 n = cross(solid.vertices[tri[1]] - solid.vertices[tri[0]], solid.vertices[tri[2]] - solid.vertices[tri[0]]);
     EXPECT_EQ(n.z, 0.0) << t;  // vertical
   }
+  // Offset, every wall stands that far outside its edge, away from the sheet.
+  const Mesh offset = meshWithSkirt(sheet, 0.01);
+  ASSERT_EQ(offset.triangles.size(), solid.triangles.size());
+  for (std::size_t v = sheet.vertices.size(); v < offset.vertices.size(); ++v) {
+    const Vec3 p = offset.vertices[v];
+    const bool outside = p.x < -0.009 || p.x > 1.009 || p.y > 1.009;  // the edge y = 0 lies on the bottom
+    EXPECT_TRUE(outside) << p.x << ", " << p.y;
+    EXPECT_TRUE(std::abs(p.x + 0.01) < 1e-12 || std::abs(p.x - 1.01) < 1e-12 || std::abs(p.y - 1.01) < 1e-12)
+        << p.x << ", " << p.y;
+  }
+  EXPECT_THROW(meshWithSkirt(sheet, -1.0), Error);
   const double radius = 0.25;
   const Vec3 a{0.5, 1.2, 0.5}, b{0.6, 1.2, 0.5};  // 0.2 beside the edge y = 1 (at z = 1), half way down
   EXPECT_TRUE(MeshDropCutter(sheet, radius).segmentClear(a, b, radius - 1e-6));

@@ -90,12 +90,14 @@ MeshRasterPaths meshRasterPaths(const MeshDropCutter& cutter, const Mesh& mesh, 
 
 /// The mesh as the top of a solid, for the cutter's proofs: below every open boundary edge
 /// (an edge of one triangle only) a vertical wall of two triangles down to the mesh's lowest
-/// z. Why: the drop heights are the same (a vertical facet touches the ball only through its
-/// top edge, which the mesh has), but a move proven against the open sheet may pass beside
-/// its edge below it (a ramp from the floor up onto the part), cutting the side of the solid
-/// the sheet is the top of; against the walls it is not proven, and is halved until it rises
-/// beside them.
-Mesh meshWithSkirt(const Mesh& mesh);
+/// z, `offset` (>= 0) outwards in xy from the edge (away from its triangle). Why: the drop
+/// heights are the same (a vertical facet touches the ball only through its top edge, which
+/// lies beside the mesh's), but a move proven against the open sheet may pass beside its edge
+/// below it (a ramp onto the part), cutting the side of the solid the sheet is the top of;
+/// against the walls it is not proven, and is halved until it rises beside them. The offset
+/// (a plan gives 4 eps) keeps a ball that grazes a wall within eps off the edge's own vertical
+/// line, which a z-map would read as cut down to the ball's equator.
+Mesh meshWithSkirt(const Mesh& mesh, double offset = 0.0);
 
 /// The flat-surface raster spacing for a scallop height H < R: 2 sqrt(2 R H - H^2).
 double meshRasterSpacing(double toolRadius, double scallopHeight);
