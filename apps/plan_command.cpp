@@ -27,6 +27,7 @@
 #include "arguments.hpp"
 #include "commands.hpp"
 #include "output_directory.hpp"
+#include "scallop/cad_tessellation.hpp"
 #include "scallop/cut_simulation.hpp"
 #include "scallop/error.hpp"
 #include "scallop/gcode.hpp"
@@ -65,7 +66,26 @@ struct PlanOptions {
   bool quiet = false;
   std::string units;          // --units in|mm: an STL mesh's
   bool dropZeroArea = false;  // --drop-zero-area: an STL mesh's
+  bool tessellate = false;    // --tessellate: a STEP/IGES part cut through its tessellation
+  std::string deflection;     // --deflection D: that tessellation's
 };
+
+// What a mesh plan cuts: an STL mesh, or the tessellation of a STEP or IGES part whose faces
+// the exact importer refuses (trimmed, rational).
+struct MeshJob {
+  Mesh mesh;
+  std::string description;        // the progress line's "4,608 triangles (binary STL)"
+  double clearance = 0.0;         // added to R in every proof: the tessellation's margin
+  const CadPart* part = nullptr;  // the exact faces: the simulated cut's design
+  std::optional<TessellationSummary> tessellation;
+};
+
+// The simulated cut's budget of vertical lines through a CAD part's exact faces: past it the
+// cut is judged on the mesh instead, and the report says so.
+constexpr std::size_t kExactDesignRays = 1'000'000;
+// The clearance a tessellated part's proofs add to R: this times the sampled deviation
+// (cad_tessellation.hpp: sampled, so a margin).
+constexpr double kDeviationMargin = 1.5;
 
 // Rounds of rest finishing at most (each a simulation of the whole program more).
 constexpr int kRestRounds = 2;
@@ -117,10 +137,11 @@ std::string restSummary(const PathsReport& report, Units units) {
 
 // `plan` on an STL mesh: raster passes of exact drop lines (mesh_raster.hpp), every move proven
 // within eps; the program written and its cut simulated on the mesh itself.
-void runPlanMesh(const PlanOptions& options) {
+void runPlanMesh(const PlanOptions& options, MeshJob job) {
   const std::string& path = options.surface.input;
+  const char* const what = job.part ? "a tessellated part" : "a mesh";
   const auto reject = [&](bool given, const char* option, const char* why) {
-    if (given) throw Error(fmt::format("{}: {} {}; not for a mesh", path, option, why));
+    if (given) throw Error(fmt::format("{}: {} {}; not for {}", path, option, why, what));
   };
   reject(!options.surface.patches.empty() || options.surface.skipFaces, "--patches/--skip-faces",
          "select a surface's patches or faces");
@@ -134,8 +155,7 @@ void runPlanMesh(const PlanOptions& options) {
     if (!options.quiet) fmt::print(stderr, "scallop plan: {}...\n", line);
   };
   const auto start = std::chrono::steady_clock::now();
-  const StlMesh stl = loadStlMesh(path, options.units, options.dropZeroArea);
-  const Mesh& mesh = stl.mesh;
+  const Mesh& mesh = job.mesh;
   const bool inch = mesh.units == Units::inch;
   const double radius = options.toolRadius.empty()
                             ? (inch ? 0.25 : 6.0)
@@ -160,10 +180,11 @@ void runPlanMesh(const PlanOptions& options) {
   const double rapidRate = options.rapidRate.empty()
                                ? defaultRapidRate(mesh.units)
                                : parsePositive(options.rapidRate, "rapid rate", "a positive rate");
-  progress(fmt::format("{} triangles ({}); raster along x, lines at most {:.6g} {} apart, each the exact drop line "
-                       "of a {} {} ball",
-                       mesh.triangles.size(), stl.format == StlFormat::binary ? "binary" : "ASCII", spacing,
-                       unitsName(mesh.units), radius, unitsName(mesh.units)));
+  progress(fmt::format("{}; raster along x, lines at most {:.6g} {} apart, each the exact drop line of a {} {} ball{}",
+                       job.description, spacing, unitsName(mesh.units), radius, unitsName(mesh.units),
+                       job.clearance > 0.0 ? fmt::format(" kept {:.3g} {} farther from the mesh", job.clearance,
+                                                         unitsName(mesh.units))
+                                           : std::string()));
   // The proofs see the mesh as the top of a solid (its open edges walled down to its bottom).
   // The walls stand 4 eps outside the edges (eps: the drop lines' 1e-6 of the mesh's size).
   double diagonal = 0.0;
@@ -176,7 +197,10 @@ void runPlanMesh(const PlanOptions& options) {
     diagonal = norm(hi - lo);
   }
   const Mesh solid = meshWithSkirt(mesh, 4e-6 * diagonal);
-  const MeshDropCutter cutter(solid, radius);
+  // A tessellated part's proofs use the ball grown by the clearance: a centre R + c from the
+  // mesh is at least R from every exact face within c of the mesh.
+  const double proofRadius = radius + job.clearance;
+  const MeshDropCutter cutter(solid, proofRadius);
   MeshRasterOptions raster;
   raster.spacing = spacing;
   // A chord of the drop line leaves at most its sag of material: a quarter of H, as the
@@ -201,15 +225,16 @@ void runPlanMesh(const PlanOptions& options) {
     double lowest = std::numeric_limits<double>::infinity();
     for (const double z : visible.z)
       if (z != -std::numeric_limits<double>::infinity()) lowest = std::min(lowest, z);
-    if (std::isfinite(lowest)) raster.floor = lowest + radius;
+    if (std::isfinite(lowest)) raster.floor = lowest + proofRadius;
   }
-  const MeshRasterPaths paths = [&] {
+  MeshRasterPaths paths = [&] {
     try {
       return meshRasterPaths(cutter, solid, raster);
     } catch (const Error& e) {
       throw Error(fmt::format("{}: {}", path, e.what()));
     }
   }();
+  paths.path.toolRadius = radius;  // the centres were proven for R + clearance; the tool is R
   // The deepest the ball comes, exactly: every move's distance to the mesh.
   double least = std::numeric_limits<double>::infinity();
   Vec3 deepestAt;
@@ -240,11 +265,12 @@ void runPlanMesh(const PlanOptions& options) {
   report.stats.centreLength = paths.centreLength;
   GougeReport gouge;
   gouge.samples = 0;
-  gouge.signedMaxDepth = radius - least;
-  gouge.maxDepth = std::max(0.0, radius - least);
+  gouge.signedMaxDepth = proofRadius - least;  // against the mesh, the ball grown by the clearance
+  gouge.maxDepth = std::max(0.0, proofRadius - least);
   gouge.depthBound = gouge.maxDepth;  // exact distances, not samples
   gouge.deepest.center = deepestAt;
   report.gouge = gouge;
+  report.tessellation = job.tessellation;
 
   progress("writing the G-code");
   const GcodeDialect dialect = gcodeDialect(options.dialect);
@@ -256,8 +282,28 @@ void runPlanMesh(const PlanOptions& options) {
   report.feedRate = gcodeOptions.feedRate;
   report.plungeFeedRate = gcodeOptions.plungeFeedRate;
   report.rapidRate = rapidRate;
-  progress("simulating the cut of the program on the mesh (scallop verify)");
-  const SimulationReport simulated = verifyProgram(mesh, parseGcodeProgram(program, programName), simulation);
+  const GcodeProgram written = parseGcodeProgram(program, programName);
+  const SimulationReport simulated = [&] {
+    if (job.part) {
+      HeightGrid grid = simulationGrid(mesh, simulation);
+      if (grid.z.size() <= kExactDesignRays) {
+        progress(fmt::format("simulating the cut of the program on the part's exact faces ({} x {} vertical lines)",
+                             grid.columns, grid.rows));
+        report.tessellation->exactDesign = true;
+        const CadPart& part = *job.part;
+        return verifyProgram(
+            mesh.units, std::move(grid), top,
+            [&part](HeightGrid& g, std::vector<double>& normalZ) { part.designHeights(g, &normalZ); }, written,
+            simulation);
+      }
+      progress(fmt::format("the simulation's {} x {} grid exceeds the budget of {} lines through the exact faces: "
+                           "simulating the cut on the mesh",
+                           grid.columns, grid.rows, kExactDesignRays));
+    } else {
+      progress("simulating the cut of the program on the mesh (scallop verify)");
+    }
+    return verifyProgram(mesh, written, simulation);
+  }();
   report.verification = verificationSummary(simulated, *simulation.stockAllowance);
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   progress("writing the report");
@@ -268,10 +314,16 @@ void runPlanMesh(const PlanOptions& options) {
                options.out);
   const std::string units(unitsName(mesh.units));
   fmt::print(stderr,
-             "scallop plan: raster on {}: {} triangles, {} lines {:.5g} to {:.5g} {} apart, tool-centre length {:.4f} {}, "
+             "scallop plan: raster on {}{}: {} triangles, {} lines {:.5g} to {:.5g} {} apart, tool-centre length {:.4f} {}, "
              "{} moves proven within eps {:.2g} ({} unproven), deepest ball interference {:.6f} {} (exact); {}; "
              "simulated: gouge {:.6f}, scallop max {:.6f} / 99% {:.6f} {}{}; {:.2f} s -> {}/\n",
-             path, mesh.triangles.size(), paths.lines, paths.minSpacing, spacing, units, paths.centreLength, units,
+             path,
+             job.tessellation
+                 ? fmt::format(" (tessellated: deviation {:.3g} {}, clearance {:.3g}; simulated on the {})",
+                               report.tessellation->deviation, unitsName(mesh.units), job.clearance,
+                               report.tessellation->exactDesign ? "exact faces" : "mesh")
+                 : std::string(),
+             mesh.triangles.size(), paths.lines, paths.minSpacing, spacing, units, paths.centreLength, units,
              paths.path.passes.empty() ? 0 : paths.path.passes[0].moves.size(), paths.eps, paths.unprovenMoves,
              gouge.maxDepth, units, cycleSummary(report, mesh.units), simulated.maxGouge, simulated.maxScallop,
              simulated.scallopP99, units,
@@ -283,12 +335,97 @@ void runPlanMesh(const PlanOptions& options) {
              report.seconds, options.out);
 }
 
+// A STEP or IGES part's tessellation as a mesh job (cad_tessellation.hpp). The deflection
+// asked of the mesher is H / 8 unless given: what the mesh's error adds to the scallops is then
+// small beside H (measured, the deviation is often 1.5-3 times the deflection).
+MeshJob tessellatedJob(const PlanOptions& options, const CadPart& part, const std::optional<CadImport>& exact) {
+  const bool inch = part.units() == Units::inch;
+  const auto progress = [&](const std::string& line) {
+    if (!options.quiet) fmt::print(stderr, "scallop plan: {}...\n", line);
+  };
+  if (exact) {
+    std::size_t trimmed = 0, rational = 0;
+    for (const SkippedFace& face : exact->skipped) {
+      trimmed += face.issue == CadFaceIssue::trimmed ? 1 : 0;
+      rational += face.issue == CadFaceIssue::rational ? 1 : 0;
+    }
+    progress(fmt::format("{} of {} faces cannot be machined exactly yet ({} trimmed, {} rational, {} other; the first: "
+                         "{}): cutting the part through its tessellation",
+                         exact->skipped.size(), part.faces(), trimmed, rational,
+                         exact->skipped.size() - trimmed - rational, exact->skipped.front().reason));
+  }
+  double deflection = 0.0;
+  if (!options.deflection.empty()) {
+    deflection = parsePositive(options.deflection, "deflection", "a positive length");
+  } else {
+    double height = inch ? 0.001 : 0.025;
+    if (!options.scallopHeight.empty()) {
+      height = parsePositive(options.scallopHeight, "scallop height", "a positive length");
+    } else if (!options.spacing.empty()) {
+      const double radius = options.toolRadius.empty()
+                                ? (inch ? 0.25 : 6.0)
+                                : parsePositive(options.toolRadius, "tool radius", "a positive length");
+      height = flatCusp(radius, parsePositive(options.spacing, "spacing", "a positive length"));
+    }
+    deflection = height / 8.0;
+  }
+  TessellationOptions tessellation;
+  tessellation.deflection = deflection;
+  progress(fmt::format("tessellating its {} faces with deflection {:.3g} {}", part.faces(), deflection,
+                       unitsName(part.units())));
+  CadTessellation mesh = part.tessellate(tessellation);
+  MeshJob job;
+  job.clearance = kDeviationMargin * mesh.deviation;
+  job.description = fmt::format("{} triangles from {} faces ({}), the exact faces at most {:.3g} {} from them (sampled "
+                                "at {} points)",
+                                mesh.mesh.triangles.size(), part.faces(), cadFormatName(part.format()), mesh.deviation,
+                                unitsName(part.units()), mesh.deviationSamples);
+  job.tessellation = TessellationSummary{part.faces(), mesh.mesh.triangles.size(), deflection, mesh.deviation,
+                                         mesh.deviationFace, job.clearance, false};
+  job.mesh = std::move(mesh.mesh);
+  return job;
+}
+
 void runPlan(const PlanOptions& options) {
   if (!options.spacing.empty() && !options.scallopHeight.empty())
     throw CLI::ValidationError("plan", "give at most one of --spacing and --scallop-height");
-  if (isStlPath(options.surface.input)) return runPlanMesh(options);
+  if (isStlPath(options.surface.input)) {
+    if (options.tessellate || !options.deflection.empty())
+      throw Error(fmt::format("{}: --tessellate and --deflection are for STEP and IGES parts; an STL file is a mesh "
+                              "already",
+                              options.surface.input));
+    const StlMesh stl = loadStlMesh(options.surface.input, options.units, options.dropZeroArea);
+    MeshJob job;
+    job.description = fmt::format("{} triangles ({})", stl.mesh.triangles.size(),
+                                  stl.format == StlFormat::binary ? "binary STL" : "ASCII STL");
+    job.mesh = stl.mesh;
+    return runPlanMesh(options, std::move(job));
+  }
   if (!options.units.empty() || options.dropZeroArea)
     throw Error("--units and --drop-zero-area are for STL meshes (a .stl file); a surface's units are in its file");
+  const bool cad = !options.surface.input.empty() && options.surface.input != "-" &&
+                   cadFormatOf(options.surface.input).has_value();
+  if (!cad && (options.tessellate || !options.deflection.empty()))
+    throw Error("--tessellate and --deflection are for STEP and IGES parts (.step, .stp, .iges, .igs)");
+  if (cad && options.surface.skipFaces && options.tessellate)
+    throw Error(fmt::format("{}: --skip-faces plans only the faces imported exactly, --tessellate all of them "
+                            "through the mesh: give one",
+                            options.surface.input));
+  if (cad && !options.surface.skipFaces) {
+    // Every face exact: the surface route below. Otherwise (or asked) the tessellation.
+    const CadPart part(options.surface.input);
+    std::optional<CadImport> exact;
+    if (!options.tessellate) exact = part.exactFaces();
+    if (options.tessellate || !exact->skipped.empty()) {
+      MeshJob job = tessellatedJob(options, part, exact);
+      job.part = &part;
+      return runPlanMesh(options, std::move(job));
+    }
+  }
+  if (!options.deflection.empty())
+    throw Error(fmt::format("{}: --deflection is for a tessellated part (--tessellate, or faces that cannot be "
+                            "machined exactly); this one is cut on its exact faces",
+                            sourceName(options.surface)));
   SurfaceSource from = options.surface;
   if (from.input.empty() && from.example.empty()) from.example = "paper-1";  // the main job
   const Surface surface = loadSurface(from, !options.quiet);
@@ -464,6 +601,13 @@ void addPlanCommand(CLI::App& app) {
                  "reach (by default, with a scallop height and adaptive spacing, up to two rounds of "
                  "them, each simulated again)");
   addStlOptions(*plan, options->units, options->dropZeroArea);
+  plan->add_flag("--tessellate", options->tessellate,
+                 "STEP/IGES: cut the part through its tessellation (raster on the mesh, proofs kept 1.5 times the "
+                 "measured deviation farther, the cut simulated on the exact faces) even when every face could be "
+                 "imported exactly; parts with trimmed or rational faces are cut so without it");
+  plan->add_option("--deflection", options->deflection,
+                   "STEP/IGES tessellation: OCCT mesher's linear deflection (default H/8)")
+      ->type_name("D");
   plan->add_option("--out", options->out, "output folder (default scallop-out)")->type_name("DIR");
   plan->add_flag("--quiet", options->quiet, "no progress lines");
   plan->callback([options] { runPlan(*options); });

@@ -16,6 +16,7 @@
 #include "arguments.hpp"
 #include "commands.hpp"
 #include "output_directory.hpp"
+#include "scallop/cad_tessellation.hpp"
 #include "scallop/cut_simulation.hpp"
 #include "scallop/error.hpp"
 #include "scallop/gcode_reader.hpp"
@@ -70,12 +71,26 @@ int runVerify(const VerifyOptions& options) {
     throw Error("--units and --drop-zero-area are for STL meshes (a .stl file); a surface's units are in its file");
   std::optional<StlMesh> stl;
   std::optional<Surface> surface;
+  // A STEP or IGES part with faces the exact importer refuses (trimmed, rational) is judged
+  // on its exact faces through OCCT (cad_tessellation.hpp), unless --skip-faces asks for the
+  // exact faces alone.
+  std::optional<CadPart> part;
   if (mesh) {
     stl = loadStlMesh(source.input, options.units, options.dropZeroArea);
+  } else if (expected == 2 && source.input != "-" && !options.skipFaces && cadFormatOf(source.input)) {
+    part.emplace(source.input);
+    if (!options.patches.empty())
+      throw Error(fmt::format("{}: --patches selects Bezier patches; give --skip-faces to judge only the faces "
+                              "imported exactly",
+                              source.input));
+    if (part->exactFaces().skipped.empty()) {
+      part.reset();
+      surface = loadSurface(source);
+    }
   } else {
     surface = loadSurface(source);
   }
-  const Units designUnits = mesh ? stl->mesh.units : surface->units;
+  const Units designUnits = mesh ? stl->mesh.units : part ? part->units() : surface->units;
   const bool inch = designUnits == Units::inch;
   simulation.scallopHeight = options.scallopHeight.empty()
                                  ? (inch ? 0.001 : 0.025)
@@ -93,8 +108,16 @@ int runVerify(const VerifyOptions& options) {
     simulation.stockAllowance = parseFinite(options.stockAllowance, "stock allowance", "a length >= 0");
 
   const GcodeProgram program = readGcodeProgram(programPath);
-  const SimulationReport report =
-      mesh ? verifyProgram(stl->mesh, program, simulation) : verifyProgram(*surface, program, simulation);
+  const SimulationReport report = [&] {
+    if (mesh) return verifyProgram(stl->mesh, program, simulation);
+    if (!part) return verifyProgram(*surface, program, simulation);
+    const Vec3 low = part->boxLow(), high = part->boxHigh();
+    const CadPart& exact = *part;
+    return verifyProgram(
+        exact.units(), simulationGrid(Vec2{low.x, low.y}, Vec2{high.x, high.y}, simulation), high.z,
+        [&exact](HeightGrid& grid, std::vector<double>& normalZ) { exact.designHeights(grid, &normalZ); }, program,
+        simulation);
+  }();
   const VerifySources sources{sourceName(source), program.sourceName == "-" ? "<stdin>" : program.sourceName,
                               program.unknownStartMoves, program.maxArcRadiusMismatch};
 

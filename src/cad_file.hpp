@@ -63,6 +63,12 @@ CadFile readCadFile(const std::string& path, CadFormat format);
 // entity in the file.
 std::string cadFaceName(const CadFile& file, const TopoDS_Face& face, std::size_t index);
 
+// The faces of `file` converted to exact Bezier patches (cad_import.hpp's contract; `path`
+// for messages). With requireSome, a file none of whose faces converts is refused (with
+// skipUnsupportedFaces); without, the result may have no patch. The caller holds cadMutex().
+CadImport convertFaces(const CadFile& file, const std::string& path, const CadImportOptions& options,
+                       bool requireSome);
+
 // OCCT's reader parameters and message printers are process-wide: every call into the
 // readers holds this.
 std::mutex& cadMutex();

@@ -463,9 +463,18 @@ CadImport importCad(const std::string& path, CadFormat format, const CadImportOp
   const auto start = std::chrono::steady_clock::now();
   const std::lock_guard<std::mutex> lock(detail::cadMutex());
   const detail::QuietMessages quiet;
-  CadImport result;
+  const detail::CadFile file = detail::readCadFile(path, format);
+  CadImport result = detail::convertFaces(file, path, options, true);
   result.format = format;
-  const detail::CadFile transferred = detail::readCadFile(path, format);
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+namespace detail {
+
+CadImport convertFaces(const CadFile& transferred, const std::string& path, const CadImportOptions& options,
+                       bool requireSome) {
+  CadImport result;
   result.surface.units = transferred.units;
   result.fileUnit = transferred.fileUnit;
 
@@ -500,11 +509,11 @@ CadImport importCad(const std::string& path, CadFormat format, const CadImportOp
   if (index == 0)
     throw Error(fmt::format("{}: no faces in the file ({} root entities transferred): nothing to machine", path,
                             transferred.roots));
-  if (result.surface.patches.empty())
+  if (requireSome && result.surface.patches.empty())
     throw Error(fmt::format("{}: none of its {} faces can be imported exactly; the first: {}", path, index,
                             result.skipped.front().reason));
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }
 
+}  // namespace detail
 }  // namespace scallop

@@ -499,6 +499,17 @@ HeightGrid simulationGrid(const Mesh& mesh, const SimulationOptions& options) {
   return gridOver(box, options);
 }
 
+HeightGrid simulationGrid(Vec2 low, Vec2 high, const SimulationOptions& options) {
+  validateOptions(options);
+  if (!(std::isfinite(low.x + low.y + high.x + high.y) && low.x <= high.x && low.y <= high.y))
+    throw Error(fmt::format("the simulation's box ({}, {}) to ({}, {}) is empty or not finite", low.x, low.y, high.x,
+                            high.y));
+  XyBox box;
+  box.add({low.x, low.y, 0.0});
+  box.add({high.x, high.y, 0.0});
+  return gridOver(box, options);
+}
+
 void designHeights(const Surface& surface, HeightGrid& grid, std::vector<double>* normalZ) {
   std::fill(grid.z.begin(), grid.z.end(), -kInf);
   if (normalZ) normalZ->assign(grid.z.size(), 0.0);
@@ -655,6 +666,21 @@ SimulationReport simulateCut(const Mesh& mesh, const std::vector<SweptMove>& mov
   for (const Vec3& v : mesh.vertices) top = std::max(top, v.z);
   SimulationReport report = reportFor(mesh.units, simulationGrid(mesh, options), top, options);
   designHeights(mesh, report.design, &report.designNormalZ);
+  report.designSeconds = secondsSince(start);
+  sweepAndCompare(report, moves, options, nullptr, start);
+  return report;
+}
+
+SimulationReport simulateCut(Units units, HeightGrid grid, double highest, const DesignHeightsFunction& design,
+                             const std::vector<SweptMove>& moves, const SimulationOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  validateOptions(options);
+  SimulationReport report = reportFor(units, std::move(grid), highest, options);
+  std::fill(report.design.z.begin(), report.design.z.end(), -kInf);
+  report.designNormalZ.assign(report.design.z.size(), 0.0);
+  design(report.design, report.designNormalZ);
+  if (report.designNormalZ.size() != report.design.z.size())
+    throw Error("the design's normals do not match its grid");  // a caller's bug, not the input's
   report.designSeconds = secondsSince(start);
   sweepAndCompare(report, moves, options, nullptr, start);
   return report;
@@ -819,6 +845,13 @@ SimulationReport verifyProgram(const Mesh& mesh, const GcodeProgram& program, co
   requireUnits(program, mesh.units, "mesh");
   validateOptions(options);
   return simulateCut(mesh, sweptMoves(program, options.toolRadius), options);
+}
+
+SimulationReport verifyProgram(Units units, HeightGrid grid, double highest, const DesignHeightsFunction& design,
+                               const GcodeProgram& program, const SimulationOptions& options) {
+  requireUnits(program, units, "part");
+  validateOptions(options);
+  return simulateCut(units, std::move(grid), highest, design, sweptMoves(program, options.toolRadius), options);
 }
 
 SimulationReport verifyToolPath(const Surface& surface, const ToolPath& path, SimulationOptions options) {

@@ -198,6 +198,18 @@ std::string pathsToJson(const PathsReport& report, const ToolPath& path) {
     verification["seconds"] = v.seconds;
     document["verification"] = std::move(verification);
   }
+  if (report.tessellation) {
+    const TessellationSummary& t = *report.tessellation;
+    Json tessellation;
+    tessellation["faces"] = t.faces;
+    tessellation["triangles"] = t.triangles;
+    tessellation["deflection"] = t.deflection;
+    tessellation["deviation"] = t.deviation;
+    tessellation["deviation_face"] = t.deviationFace;
+    tessellation["clearance"] = t.clearance;
+    tessellation["design"] = t.exactDesign ? "exact faces" : "mesh";
+    document["tessellation"] = std::move(tessellation);
+  }
   if (report.restFinishing) {
     Json rounds = Json::array();
     for (const RestRound& round : report.restRounds) {

@@ -101,6 +101,7 @@
 //         over its budget (maxEvaluations, counted before sweeping).
 
 #include <cstddef>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <string>
@@ -237,6 +238,14 @@ HeightGrid simulationGrid(const Surface& surface, const SimulationOptions& optio
 /// The same over a mesh's vertices.
 HeightGrid simulationGrid(const Mesh& mesh, const SimulationOptions& options);
 
+/// The same over the xy box [low, high] (a part known by its bounding box: a CAD part's).
+HeightGrid simulationGrid(Vec2 low, Vec2 high, const SimulationOptions& options);
+
+/// Design heights from elsewhere (a STEP or IGES part's exact faces, cad_tessellation.hpp):
+/// fills grid.z (-infinity off the part) and normalZ (|n_z| of the unit normal per point,
+/// sized as grid.z; 0 where there is no surface).
+using DesignHeightsFunction = std::function<void(HeightGrid& grid, std::vector<double>& normalZ)>;
+
 /// The highest triangle of `mesh` over every point of `grid` (see the contract's Meshes);
 /// `normalZ`, if given, receives |n_z| of its unit normal (0 where there is none).
 void designHeights(const Mesh& mesh, HeightGrid& grid, std::vector<double>* normalZ = nullptr);
@@ -272,12 +281,22 @@ SimulationReport simulateCut(const Surface& surface, const std::vector<SweptMove
 SimulationReport simulateCut(const Mesh& mesh, const std::vector<SweptMove>& moves,
                              const SimulationOptions& options);
 
+/// The whole simulation on `grid` (from simulationGrid, heights -infinity) with the design
+/// from `design`; `highest` is the part's highest point (the default stock top). Points left
+/// above H are not classified by reach (as on a mesh).
+SimulationReport simulateCut(Units units, HeightGrid grid, double highest, const DesignHeightsFunction& design,
+                             const std::vector<SweptMove>& moves, const SimulationOptions& options);
+
 /// simulateCut on a program (its units must be the surface's).
 SimulationReport verifyProgram(const Surface& surface, const GcodeProgram& program,
                                const SimulationOptions& options);
 
 /// simulateCut on a program over a mesh (its units must be the mesh's).
 SimulationReport verifyProgram(const Mesh& mesh, const GcodeProgram& program, const SimulationOptions& options);
+
+/// simulateCut on a program with the design from `design` (the program's units must be `units`).
+SimulationReport verifyProgram(Units units, HeightGrid grid, double highest, const DesignHeightsFunction& design,
+                               const GcodeProgram& program, const SimulationOptions& options);
 
 /// simulateCut on a tool path (options.toolRadius 0 takes path.toolRadius).
 SimulationReport verifyToolPath(const Surface& surface, const ToolPath& path, SimulationOptions options);

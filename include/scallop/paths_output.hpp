@@ -82,6 +82,18 @@ struct ScallopReport {
   CuspStatistics cusp;          ///< estimated cusp heights (an estimate: see cusp.hpp)
 };
 
+/// A STEP or IGES part cut through its tessellation (cad_tessellation.hpp): how far the mesh
+/// stands from the exact faces, and what the plan did about it.
+struct TessellationSummary {
+  std::size_t faces = 0;
+  std::size_t triangles = 0;
+  double deflection = 0.0;     ///< D asked of OCCT's mesher
+  double deviation = 0.0;      ///< sampled max distance from the exact faces to their triangles
+  std::size_t deviationFace = 0;
+  double clearance = 0.0;      ///< added to R in every proof against the mesh
+  bool exactDesign = false;    ///< the simulated cut judged against the exact faces (else the mesh)
+};
+
 struct PathsReport {
   std::string strategy;            ///< "contour" or "raster"
   std::string source;              ///< the surface's file or example name
@@ -113,6 +125,8 @@ struct PathsReport {
   /// passes added after a simulated cut, with the simulated figures before the round (the
   /// `verification` above is of the final program). Empty: none was run or needed.
   std::vector<RestRound> restRounds;
+  /// A STEP or IGES part cut through its tessellation; none for exact surfaces and STL.
+  std::optional<TessellationSummary> tessellation;
   bool restFinishing = false;  ///< rest finishing was on (the rounds may still be none)
   /// The G-code program's motion and estimated cycle time (gcode.hpp's gcodeMotion), with
   /// the rates it assumed (units per minute).
