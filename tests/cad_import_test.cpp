@@ -42,6 +42,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cad_fixtures.hpp"
 #include "cli_fixture.hpp"
 #include "message_checks.hpp"
 #include "scallop/bezier.hpp"
@@ -59,78 +60,16 @@ using scallop::CadImport;
 using scallop::Surface;
 using scallop::Vec3;
 
+using scallop::test::facesOf;
+using scallop::test::faceOf;
+using scallop::test::bsplineOf;
+using scallop::test::writeIges;
+using scallop::test::writeStep;
+using CadImportTest = scallop::test::CadTempDir;
+
 const std::string kExamples = SCALLOP_EXAMPLES_DIR;
 
 Surface exampleFile(const std::string& name) { return scallop::readSurface(kExamples + "/surfaces/" + name + ".json"); }
-
-// OCCT's writers print statistics on standard output: not in the test log.
-void quietOcct() { Message::DefaultMessenger()->ChangePrinters().Clear(); }
-
-Handle(Geom_BSplineSurface) bsplineOf(const BezierPatch& patch, double scale = 1.0) {
-  TColgp_Array2OfPnt poles(1, patch.degreeU + 1, 1, patch.degreeV + 1);
-  for (int j = 0; j <= patch.degreeU; ++j)
-    for (int k = 0; k <= patch.degreeV; ++k) {
-      const Vec3& p = patch.at(j, k);
-      poles(j + 1, k + 1) = gp_Pnt(scale * p.x, scale * p.y, scale * p.z);
-    }
-  TColStd_Array1OfReal knots(1, 2);
-  knots(1) = 0.0;
-  knots(2) = 1.0;
-  TColStd_Array1OfInteger multsU(1, 2), multsV(1, 2);
-  multsU.Init(patch.degreeU + 1);
-  multsV.Init(patch.degreeV + 1);
-  return new Geom_BSplineSurface(poles, knots, knots, multsU, multsV, patch.degreeU, patch.degreeV);
-}
-
-TopoDS_Face faceOf(const Handle(Geom_Surface)& surface) {
-  BRepBuilderAPI_MakeFace make(surface, Precision::Confusion());
-  EXPECT_TRUE(make.IsDone());
-  return make.Face();
-}
-
-// Every patch of `surface` as a face of its own, in order.
-TopoDS_Shape facesOf(const Surface& surface, double scale = 1.0) {
-  BRep_Builder builder;
-  TopoDS_Compound compound;
-  builder.MakeCompound(compound);
-  for (const BezierPatch& patch : surface.patches) builder.Add(compound, faceOf(bsplineOf(patch, scale)));
-  return compound;
-}
-
-// OCCT's writers take the shape in millimetres (their "cascade unit") and convert to the
-// file's `unit`, "MM" or "INCH" (IGES: "MM" or "IN"), with 13 (STEP) or 10 (IGES) significant
-// digits: an inch file of coordinates p is written from the shape scaled by 25.4 (facesOf's
-// scale).
-void writeStep(const TopoDS_Shape& shape, const fs::path& path, const char* unit) {
-  quietOcct();
-  STEPControl_Controller::Init();
-  Interface_Static::SetCVal("xstep.cascade.unit", "MM");
-  Interface_Static::SetCVal("write.step.unit", unit);
-  STEPControl_Writer writer;
-  ASSERT_EQ(writer.Transfer(shape, STEPControl_AsIs), IFSelect_RetDone);
-  ASSERT_EQ(writer.Write(path.string().c_str()), IFSelect_RetDone);
-}
-
-void writeIges(const TopoDS_Shape& shape, const fs::path& path, const char* unit) {
-  quietOcct();
-  IGESControl_Controller::Init();
-  Interface_Static::SetCVal("xstep.cascade.unit", "MM");
-  IGESControl_Writer writer(unit, 1);  // 1: B-rep faces (type 510/514), not trimmed surfaces
-  ASSERT_TRUE(writer.AddShape(shape));
-  writer.ComputeModel();
-  ASSERT_TRUE(writer.Write(path.string().c_str()));
-}
-
-class CadImportTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    std::string pattern = (fs::temp_directory_path() / "scallop-cad-XXXXXX").string();
-    ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
-    dir_ = pattern;
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  fs::path dir_;
-};
 
 // The largest distance between the patches at an n x n grid (both in [0, 1]^2), relative to
 // the size of `a`.
