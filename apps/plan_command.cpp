@@ -135,11 +135,10 @@ std::string restSummary(const PathsReport& report, Units units) {
                      length, unitsName(units), targets, first.maxScallopBefore);
 }
 
-// `plan` on an STL mesh: raster passes of exact drop lines (mesh_raster.hpp), every move proven
-// within eps; the program written and its cut simulated on the mesh itself.
-void runPlanMesh(const PlanOptions& options, MeshJob job) {
+// The options a mesh plan (an STL mesh, a tessellated part: `what`) cannot honour, refused
+// by name before any work.
+void rejectMeshOptions(const PlanOptions& options, const char* what) {
   const std::string& path = options.surface.input;
-  const char* const what = job.part ? "a tessellated part" : "a mesh";
   const auto reject = [&](bool given, const char* option, const char* why) {
     if (given) throw Error(fmt::format("{}: {} {}; not for {}", path, option, why, what));
   };
@@ -151,6 +150,14 @@ void runPlanMesh(const PlanOptions& options, MeshJob job) {
   reject(options.constantSpacing, "--constant-spacing", "is the optimal planes' flat-surface spacing");
   reject(options.noLinking || options.oneWay, "--no-linking/--one-way", "order a surface plan's passes (a mesh's raster is one zigzag)");
   reject(options.noRestFinishing, "--no-rest-finishing", "switches off what a mesh plan does not do yet");
+}
+
+// `plan` on an STL mesh: raster passes of exact drop lines (mesh_raster.hpp), every move proven
+// within eps; the program written and its cut simulated on the mesh itself.
+void runPlanMesh(const PlanOptions& options, MeshJob job) {
+  const std::string& path = options.surface.input;
+  const char* const what = job.part ? "a tessellated part" : "a mesh";
+  rejectMeshOptions(options, what);
   auto progress = [&](const std::string& line) {
     if (!options.quiet) fmt::print(stderr, "scallop plan: {}...\n", line);
   };
@@ -417,6 +424,7 @@ void runPlan(const PlanOptions& options) {
     std::optional<CadImport> exact;
     if (!options.tessellate) exact = part.exactFaces();
     if (options.tessellate || !exact->skipped.empty()) {
+      rejectMeshOptions(options, "a tessellated part");
       MeshJob job = tessellatedJob(options, part, exact);
       job.part = &part;
       return runPlanMesh(options, std::move(job));

@@ -1,0 +1,418 @@
+// CadPart (cad_tessellation.hpp): the tessellation of STEP and IGES parts whose faces are
+// trimmed or rational, the deviation it reports against a dense independent sample, the exact
+// heights against closed forms and against scallop's own Bezier design, and `scallop plan` /
+// `scallop verify` on such parts, judged by OCCT's exact point-to-solid distance.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <map>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <BRepAlgoAPI_Cut.hxx>
+#include <BRepBuilderAPI_MakeEdge.hxx>
+#include <BRepBuilderAPI_MakeFace.hxx>
+#include <BRepBuilderAPI_MakeVertex.hxx>
+#include <BRepBuilderAPI_MakeWire.hxx>
+#include <BRepExtrema_DistShapeShape.hxx>
+#include <BRepLib.hxx>
+#include <BRepPrimAPI_MakeBox.hxx>
+#include <BRepPrimAPI_MakeCylinder.hxx>
+#include <Geom2d_Circle.hxx>
+#include <TopoDS_Edge.hxx>
+#include <TopoDS_Wire.hxx>
+#include <gp_Ax2.hxx>
+#include <gp_Ax2d.hxx>
+
+#include <nlohmann/json.hpp>
+
+#include "cad_fixtures.hpp"
+#include "cli_fixture.hpp"
+#include "message_checks.hpp"
+#include "scallop/cad_tessellation.hpp"
+#include "scallop/cut_simulation.hpp"
+#include "scallop/error.hpp"
+#include "scallop/gcode_reader.hpp"
+#include "scallop/surface_io.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using scallop::CadPart;
+using scallop::CadTessellation;
+using scallop::HeightGrid;
+using scallop::Surface;
+using scallop::Vec3;
+using scallop::test::CadTempDir;
+using scallop::test::writeIges;
+using scallop::test::writeStep;
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// `call` throws scallop::Error naming every one of `parts`.
+template <class Call>
+void expectErrorMentions(Call call, const std::vector<std::string>& parts) {
+  try {
+    call();
+  } catch (const scallop::Error& error) {
+    scallop::test::expectMessageContains(error.what(), parts, "the call");
+    return;
+  }
+  ADD_FAILURE() << "accepted; expected an error naming " << parts.front();
+}
+const std::string kExamples = SCALLOP_EXAMPLES_DIR;
+const std::string kOcctSamples = "/usr/share/opencascade/data";
+
+Surface exampleFile(const std::string& name) { return scallop::readSurface(kExamples + "/surfaces/" + name + ".json"); }
+
+// A 20 x 20 x 10 mm block with a cylindrical pocket of radius 4 around (10, 10) down to z = 6:
+// its top face is trimmed by the pocket's rim and the pocket's wall is a cylinder (rational).
+TopoDS_Shape pocketBlock() {
+  const TopoDS_Shape block = BRepPrimAPI_MakeBox(gp_Pnt(0, 0, 0), 20.0, 20.0, 10.0).Shape();
+  const TopoDS_Shape pocket = BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(10, 10, 6), gp_Dir(0, 0, 1)), 4.0, 10.0).Shape();
+  BRepAlgoAPI_Cut cut(block, pocket);
+  EXPECT_TRUE(cut.IsDone());
+  return cut.Shape();
+}
+
+// The block's height over (x, y), in closed form; NaN within `band` of an edge seen from above
+// (where a vertical line grazes a wall and either answer is right).
+double pocketBlockHeight(double x, double y, double band) {
+  const double r = std::hypot(x - 10.0, y - 10.0);
+  const double inside = std::min({x, 20.0 - x, y, 20.0 - y});
+  if (std::abs(r - 4.0) < band || std::abs(inside) < band) return std::nan("");
+  if (inside < 0.0) return -kInf;
+  return r < 4.0 ? 6.0 : 10.0;
+}
+
+// Paper-1's patch (inches, written in mm) trimmed to the disk of radius 0.3 around the middle
+// of its parameter square: x = 3 v, y = 3 u on that patch, so the face is the part of the
+// surface over the disk of radius 0.9 in around (1.5, 1.5) in.
+TopoDS_Shape paperDiskFace(const Surface& paper) {
+  const Handle(Geom_BSplineSurface) surface = scallop::test::bsplineOf(paper.patches[0], 25.4);
+  const Handle(Geom2d_Circle) circle = new Geom2d_Circle(gp_Ax2d(gp_Pnt2d(0.5, 0.5), gp_Dir2d(1, 0)), 0.3);
+  TopoDS_Edge edge = BRepBuilderAPI_MakeEdge(circle, surface).Edge();
+  BRepLib::BuildCurves3d(edge);
+  const TopoDS_Wire wire = BRepBuilderAPI_MakeWire(edge).Wire();
+  BRepBuilderAPI_MakeFace face(surface, wire, Standard_True);
+  EXPECT_TRUE(face.IsDone());
+  return face.Face();
+}
+
+HeightGrid gridOver(double x0, double y0, double x1, double y1, double spacing) {
+  HeightGrid grid;
+  grid.x0 = x0;
+  grid.y0 = y0;
+  grid.spacing = spacing;
+  grid.columns = static_cast<std::size_t>(std::floor((x1 - x0) / spacing)) + 1;
+  grid.rows = static_cast<std::size_t>(std::floor((y1 - y0) / spacing)) + 1;
+  grid.z.assign(grid.columns * grid.rows, -kInf);
+  return grid;
+}
+
+// The distance from p to triangle abc by brute force over a fine barycentric lattice and the
+// edges' closest points: an upper bound of the true distance within (lattice step x size).
+// (Not the code under test's closed form.)
+double distanceToTriangle(Vec3 p, Vec3 a, Vec3 b, Vec3 c) {
+  // Project onto the plane; inside the triangle the distance is the plane's.
+  const Vec3 n = cross(b - a, c - a);
+  const double area2 = dot(n, n);
+  const Vec3 q = p - (dot(p - a, n) / area2) * n;
+  const double wa = dot(cross(b - q, c - q), n) / area2, wb = dot(cross(c - q, a - q), n) / area2;
+  const double wc = 1.0 - wa - wb;
+  if (wa >= 0.0 && wb >= 0.0 && wc >= 0.0) return norm(p - q);
+  double best = kInf;
+  const auto segment = [&](Vec3 s, Vec3 e) {
+    const Vec3 d = e - s;
+    const double t = std::clamp(dot(p - s, d) / dot(d, d), 0.0, 1.0);
+    best = std::min(best, norm(p - (s + t * d)));
+  };
+  segment(a, b);
+  segment(b, c);
+  segment(c, a);
+  return best;
+}
+
+// The distance from p to the mesh, over the triangles whose bounding box grown by `reach`
+// contains p (every triangle that can be within `reach`); infinity when none.
+double distanceToMesh(const scallop::Mesh& mesh, Vec3 p, double reach) {
+  double best = kInf;
+  for (const auto& t : mesh.triangles) {
+    const Vec3 a = mesh.vertices[t[0]], b = mesh.vertices[t[1]], c = mesh.vertices[t[2]];
+    if (p.x < std::min({a.x, b.x, c.x}) - reach || p.x > std::max({a.x, b.x, c.x}) + reach) continue;
+    if (p.y < std::min({a.y, b.y, c.y}) - reach || p.y > std::max({a.y, b.y, c.y}) + reach) continue;
+    if (p.z < std::min({a.z, b.z, c.z}) - reach || p.z > std::max({a.z, b.z, c.z}) + reach) continue;
+    best = std::min(best, distanceToTriangle(p, a, b, c));
+  }
+  return best;
+}
+
+// --- tessellation -----------------------------------------------------------------------------
+
+using CadTessellationTest = CadTempDir;
+
+TEST_F(CadTessellationTest, TheMeshOfATrimmedFreeFormFaceIsWithinItsReportedDeviationOfADenseSample) {
+  const Surface paper = exampleFile("paper-1");
+  const fs::path path = dir_ / "disk.step";
+  writeStep(paperDiskFace(paper), path, "INCH");
+  const CadPart part(path.string());
+  EXPECT_EQ(part.units(), scallop::Units::inch);
+  EXPECT_EQ(part.faces(), 1u);
+  const scallop::CadImport exact = part.exactFaces();
+  ASSERT_EQ(exact.skipped.size(), 1u);
+  EXPECT_EQ(exact.skipped[0].issue, scallop::CadFaceIssue::trimmed);
+
+  for (const double deflection : {0.01, 0.002}) {
+    scallop::TessellationOptions options;
+    options.deflection = deflection;
+    const CadTessellation mesh = part.tessellate(options);
+    ASSERT_GT(mesh.mesh.triangles.size(), 10u);
+    EXPECT_EQ(mesh.mesh.units, scallop::Units::inch);
+    EXPECT_GT(mesh.deviation, 0.0);
+    EXPECT_EQ(mesh.deviationSamples, 12 * mesh.mesh.triangles.size());
+    // Every vertex lies on the surface and over the disk (x = 3v, y = 3u): inside to STEP's
+    // 13 digits, on the boundary to the tolerance of the edge's 3D curve (BRepLib fits it to
+    // the circle on the surface; 1.3e-7 in measured).
+    for (const Vec3& v : mesh.mesh.vertices) {
+      EXPECT_LE(std::hypot(v.x - 1.5, v.y - 1.5), 0.9 + 1e-6);
+      EXPECT_NEAR(v.z, scallop::point(paper.patches[0], v.y / 3.0, v.x / 3.0).z, 1e-6);
+    }
+    // A dense independent sample of the exact face (a polar grid over the disk) lies within
+    // the margin plan uses (1.5 x the sampled deviation) of the mesh.
+    double worst = 0.0;
+    for (int i = 0; i <= 40; ++i) {
+      for (int k = 0; k < 96; ++k) {
+        const double r = 0.9 * std::sqrt(i / 40.0) * (1.0 - 1e-9), t = 2.0 * M_PI * k / 96.0;
+        const double x = 1.5 + r * std::cos(t), y = 1.5 + r * std::sin(t);
+        const Vec3 p = scallop::point(paper.patches[0], y / 3.0, x / 3.0);
+        worst = std::max(worst, distanceToMesh(mesh.mesh, p, 0.05));
+      }
+    }
+    EXPECT_LE(worst, 1.5 * mesh.deviation) << "deflection " << deflection;
+    EXPECT_GT(worst, 0.2 * mesh.deviation) << "deflection " << deflection;  // the report is not inflated either
+  }
+}
+
+TEST_F(CadTessellationTest, ThePocketBlockIsClosedOrientedAndWithinItsDeviation) {
+  const fs::path path = dir_ / "pocket.step";
+  writeStep(pocketBlock(), path, "MM");
+  const CadPart part(path.string());
+  EXPECT_EQ(part.units(), scallop::Units::millimetre);
+  scallop::TessellationOptions options;
+  options.deflection = 0.01;
+  const CadTessellation mesh = part.tessellate(options);
+  // Merged at shared edges: every edge is used by exactly two triangles, once each way, and
+  // the normals point out of the block (its signed volume is positive: 20 x 20 x 10 minus
+  // the pocket, pi 4^2 4, up to the chords).
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> edges;
+  double volume = 0.0;
+  for (const auto& t : mesh.mesh.triangles) {
+    for (int e = 0; e < 3; ++e) ++edges[{t[e], t[(e + 1) % 3]}];
+    const Vec3 a = mesh.mesh.vertices[t[0]], b = mesh.mesh.vertices[t[1]], c = mesh.mesh.vertices[t[2]];
+    volume += dot(a, cross(b, c)) / 6.0;
+  }
+  for (const auto& [edge, count] : edges) {
+    EXPECT_EQ(count, 1);
+    EXPECT_EQ(edges.count({edge.second, edge.first}), 1u) << "open edge " << edge.first << "-" << edge.second;
+  }
+  // Planes are exact; the cylinder's chords sag by at most the deflection asked, r (1 - cos),
+  // inward, so the pocket's polygon is smaller than its circle by at most deviation x its
+  // perimeter per unit of depth.
+  EXPECT_GT(mesh.deviation, 0.0);
+  EXPECT_LE(mesh.deviation, 0.01 * 1.0001);
+  const double solid = 4000.0 - M_PI * 16.0 * 4.0;
+  EXPECT_GT(volume, solid);
+  EXPECT_LE(volume, solid + mesh.deviation * 2.0 * M_PI * 4.0 * 4.0);
+}
+
+TEST_F(CadTessellationTest, BadOptionsAreRefusedByName) {
+  const fs::path path = dir_ / "pocket.step";
+  writeStep(pocketBlock(), path, "MM");
+  const CadPart part(path.string());
+  scallop::TessellationOptions options;
+  for (const double deflection : {0.0, -1.0, std::nan(""), kInf, 1e-9}) {
+    options.deflection = deflection;
+    expectErrorMentions([&] { (void)part.tessellate(options); }, {"deflection"});
+  }
+  options.deflection = 0.1;
+  options.angularDeflection = 0.0;
+  expectErrorMentions([&] { (void)part.tessellate(options); }, {"angular deflection"});
+  options.angularDeflection = 0.35;
+  options.maxTriangles = 10;
+  expectErrorMentions([&] { (void)part.tessellate(options); }, {"pocket.step", "budget"});
+}
+
+// --- exact heights ----------------------------------------------------------------------------
+
+TEST_F(CadTessellationTest, ExactHeightsOfThePocketBlockAreItsClosedForm) {
+  const fs::path path = dir_ / "pocket.iges";
+  writeIges(pocketBlock(), path, "MM");
+  const CadPart part(path.string());
+  HeightGrid grid = gridOver(-1.0, -1.0, 21.0, 21.0, 0.173);
+  std::vector<double> normalZ;
+  part.designHeights(grid, &normalZ);
+  std::size_t compared = 0;
+  for (std::size_t j = 0; j < grid.rows; ++j)
+    for (std::size_t i = 0; i < grid.columns; ++i) {
+      const scallop::Vec2 p = grid.point(i, j);
+      const double expected = pocketBlockHeight(p.x, p.y, 1e-6);
+      if (std::isnan(expected)) continue;
+      ++compared;
+      const double z = grid.z[j * grid.columns + i];
+      if (expected == -kInf) {
+        EXPECT_EQ(z, -kInf) << p.x << ", " << p.y;
+      } else {
+        EXPECT_NEAR(z, expected, 1e-7) << p.x << ", " << p.y;
+        EXPECT_NEAR(normalZ[j * grid.columns + i], 1.0, 1e-12);
+      }
+    }
+  EXPECT_GT(compared, 15000u);
+
+  // The same bits on one thread and on four.
+  HeightGrid one = gridOver(-1.0, -1.0, 21.0, 21.0, 0.173), four = one;
+  part.designHeights(one, nullptr, {1, 1'000'000});
+  part.designHeights(four, nullptr, {4, 1'000'000});
+  EXPECT_EQ(one.z, grid.z);
+  EXPECT_EQ(four.z, grid.z);
+  // The budget of lines.
+  HeightGrid fine = gridOver(-1.0, -1.0, 21.0, 21.0, 0.01);
+  expectErrorMentions([&] { part.designHeights(fine, nullptr, {0, 100'000}); },
+                                     {"pocket.iges", "budget", "100000"});
+}
+
+TEST_F(CadTessellationTest, ExactHeightsOfATrimmedFreeFormFaceAreTheBezierSurfacesInsideItsTrim) {
+  const Surface paper = exampleFile("paper-1");
+  const fs::path path = dir_ / "disk.step";
+  writeStep(paperDiskFace(paper), path, "INCH");
+  const CadPart part(path.string());
+  HeightGrid exact = gridOver(0.0, 0.0, 3.0, 3.0, 0.0213);
+  HeightGrid bezier = exact;
+  std::vector<double> exactNormalZ, bezierNormalZ;
+  part.designHeights(exact, &exactNormalZ);
+  scallop::designHeights(paper, bezier, &bezierNormalZ);  // scallop's Newton on the untrimmed patch
+  std::size_t inside = 0;
+  for (std::size_t j = 0; j < exact.rows; ++j)
+    for (std::size_t i = 0; i < exact.columns; ++i) {
+      const scallop::Vec2 p = exact.point(i, j);
+      const double r = std::hypot(p.x - 1.5, p.y - 1.5);
+      const std::size_t at = j * exact.columns + i;
+      if (std::abs(r - 0.9) < 1e-6) continue;
+      if (r > 0.9) {
+        EXPECT_EQ(exact.z[at], -kInf) << p.x << ", " << p.y;
+        continue;
+      }
+      ++inside;
+      EXPECT_NEAR(exact.z[at], bezier.z[at], 1e-9) << p.x << ", " << p.y;
+      EXPECT_NEAR(exactNormalZ[at], bezierNormalZ[at], 1e-9) << p.x << ", " << p.y;
+    }
+  EXPECT_GT(inside, 5000u);
+}
+
+// --- the CLI ----------------------------------------------------------------------------------
+
+class CadTessellationCli : public scallop::test::CliFixture {
+ protected:
+  // The least distance from the ball centres of `program` (every move's end and, along each
+  // feed line, points every R/4) to the solid of `shape`, by OCCT's exact BRepExtrema (0 for
+  // a centre inside the solid), over at most `budget` centres spread evenly.
+  static double leastCentreDistance(const TopoDS_Shape& shape, const fs::path& program, double radius,
+                                    std::size_t budget) {
+    const scallop::GcodeProgram parsed = scallop::readGcodeProgram(program.string());
+    const std::vector<scallop::SweptMove> moves = scallop::sweptMoves(parsed, radius);
+    std::vector<Vec3> centres;
+    for (const scallop::SweptMove& move : moves) {
+      if (move.kind != scallop::MoveKind::line) {
+        centres.push_back(move.end);
+        continue;
+      }
+      const double length = norm(move.end - move.start);
+      const int steps = std::max(1, static_cast<int>(std::ceil(length / (0.25 * radius))));
+      for (int s = 1; s <= steps; ++s) centres.push_back(move.start + (static_cast<double>(s) / steps) * (move.end - move.start));
+    }
+    const std::size_t stride = std::max<std::size_t>(1, centres.size() / budget);
+    double least = kInf;
+    for (std::size_t c = 0; c < centres.size(); c += stride) {
+      const Vec3 p = centres[c];
+      BRepExtrema_DistShapeShape distance(BRepBuilderAPI_MakeVertex(gp_Pnt(p.x, p.y, p.z)).Vertex(), shape);
+      EXPECT_TRUE(distance.IsDone());
+      // Inside the solid (the block and OCCT's samples are closed solids): distance 0.
+      least = std::min(least, distance.InnerSolution() ? 0.0 : distance.Value());
+    }
+    return least;
+  }
+};
+
+TEST_F(CadTessellationCli, PlanCutsATrimmedRationalPartThroughItsTessellationWithoutGouging) {
+  const TopoDS_Shape block = pocketBlock();
+  writeStep(block, workDir_ / "pocket.step", "MM");
+  const scallop::test::RunResult plan =
+      run("plan pocket.step --tool-radius 1.5 --scallop-height 0.05 --out out");
+  ASSERT_EQ(plan.exitCode, 0) << plan.err;
+  EXPECT_NE(plan.err.find("faces cannot be machined exactly yet"), std::string::npos) << plan.err;
+  EXPECT_NE(plan.err.find("simulated on the exact faces"), std::string::npos) << plan.err;
+  const auto report = nlohmann::json::parse(scallop::test::readFile(workDir_ / "out" / "report.json"));
+  EXPECT_EQ(report["units"], "mm");
+  EXPECT_EQ(report["tessellation"]["design"], "exact faces");
+  EXPECT_GT(report["tessellation"]["clearance"].get<double>(), report["tessellation"]["deviation"].get<double>());
+  EXPECT_LE(report["verification"]["max_gouge"].get<double>(), 0.0025);
+  // The ball reaches into the pocket (radius 4 > R): the floor at z = 6 is cut to near H.
+  // OCCT's exact distance from the ball centres to the solid: never below R.
+  const double least = leastCentreDistance(block, workDir_ / "out" / "toolpath.ngc", 1.5, 4000);
+  EXPECT_GE(least, 1.5 - 1e-6);
+  EXPECT_LE(least, 1.5 + 0.05);  // and it does touch the part
+  // verify judges the program on the exact faces: no gouge.
+  const scallop::test::RunResult verify = run(
+      "verify pocket.step out/toolpath.ngc --radius 1.5 --scallop-height 0.05 --stock-allowance 0.25 --fail-on-gouge "
+      "--json verify.json");
+  ASSERT_EQ(verify.exitCode, 0) << verify.err;
+  const auto judged = nlohmann::json::parse(scallop::test::readFile(workDir_ / "verify.json"));
+  EXPECT_LE(judged["gouge"]["max"].get<double>(), 0.0025);
+}
+
+TEST_F(CadTessellationCli, PlanAndVerifyOpenCascadesSampleStepAndIgesParts) {
+  // Parts nobody here wrote: OCCT's screw.step (planes, cones, cylinders and tori) and
+  // bearing.iges (213 B-spline faces, 55 trimmed).
+  struct Sample {
+    std::string file;
+    std::string radius;
+    std::string height;
+  };
+  for (const Sample& sample : {Sample{"step/screw.step", "3", "0.05"}, Sample{"iges/bearing.iges", "0.004", "0.0008"}}) {
+    const std::string path = kOcctSamples + "/" + sample.file;
+    if (!fs::exists(path)) GTEST_FAIL() << path << " is missing: Debian's occt-misc package installs it";
+    const scallop::test::RunResult plan = run("plan " + path + " --tool-radius " + sample.radius +
+                                              " --scallop-height " + sample.height + " --out out --quiet");
+    ASSERT_EQ(plan.exitCode, 0) << sample.file << ": " << plan.err;
+    const auto report = nlohmann::json::parse(scallop::test::readFile(workDir_ / "out" / "report.json"));
+    EXPECT_EQ(report["tessellation"]["design"], "exact faces") << sample.file;
+    EXPECT_LE(report["verification"]["max_gouge"].get<double>(), 0.0025) << sample.file;
+    const scallop::test::RunResult verify =
+        run("verify " + path + " out/toolpath.ngc --radius " + sample.radius + " --scallop-height " + sample.height +
+            " --stock-allowance 0.25 --fail-on-gouge");
+    EXPECT_EQ(verify.exitCode, 0) << sample.file << ": " << verify.err;
+    fs::remove_all(workDir_ / "out");
+  }
+}
+
+TEST_F(CadTessellationCli, TessellationOptionsAreRefusedWhereTheyDoNotApply) {
+  writeStep(pocketBlock(), workDir_ / "pocket.step", "MM");
+  expectCleanFailure(run("plan pocket.step --tessellate --skip-faces --out out"), {"pocket.step", "--skip-faces"},
+                     "pocket.step");
+  expectCleanFailure(run("plan pocket.step --deflection 0 --out out --quiet"), {"deflection", "0"}, "pocket.step");
+  expectCleanFailure(run("plan pocket.step --deflection 1e-9 --out out --quiet"), {"pocket.step", "deflection", "1e-06"},
+                     "pocket.step");
+  expectCleanFailure(run("plan pocket.step --strategy contour --out out"), {"pocket.step", "contour", "tessellated"},
+                     "pocket.step");
+  expectCleanFailure(run("plan --example paper-1 --deflection 0.1 --out out"), {"--deflection"}, "pocket.step");
+  fs::remove(workDir_ / "pocket.step");
+  fs::copy_file(kExamples + "/surfaces/paper-1.json", workDir_ / "paper-1.json");
+  expectCleanFailure(run("plan paper-1.json --tessellate --out out"), {"--tessellate", "STEP and IGES"},
+                     "paper-1.json");
+}
+
+}  // namespace
