@@ -162,7 +162,7 @@ void printSummary(const std::string& source, const OptimalSlicing& result, bool 
 
 void runOrient(const OrientOptions& options) {
   checkOptions(options);
-  if (isStlPath(options.surface.input)) {
+  if (isStlSource(options.surface.input)) {
     runOrientMesh(options);
     return;
   }

@@ -71,7 +71,7 @@ void runPaths(const PathsOptions& options) {
   job.constantSpacing = options.constantSpacing;
   job.linking.direction = options.oneWay ? PassDirection::keep : PassDirection::zigzag;
 
-  if (isStlPath(options.surface.input))
+  if (isStlSource(options.surface.input))
     throw Error(fmt::format("{}: paths takes Bezier surfaces (JSON, .bpt, STEP, IGES); an STL mesh goes through "
                             "scallop plan (raster by exact drop lines)", options.surface.input));
   const Surface surface = loadSurface(options.surface);

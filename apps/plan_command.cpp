@@ -138,7 +138,7 @@ std::string restSummary(const PathsReport& report, Units units) {
 // The options a mesh plan (an STL mesh, a tessellated part: `what`) cannot honour, refused
 // by name before any work.
 void rejectMeshOptions(const PlanOptions& options, const char* what) {
-  const std::string& path = options.surface.input;
+  const std::string path = sourceName(options.surface);
   const auto reject = [&](bool given, const char* option, const char* why) {
     if (given) throw Error(fmt::format("{}: {} {}; not for {}", path, option, why, what));
   };
@@ -155,7 +155,7 @@ void rejectMeshOptions(const PlanOptions& options, const char* what) {
 // `plan` on an STL mesh: raster passes of exact drop lines (mesh_raster.hpp), every move proven
 // within eps; the program written and its cut simulated on the mesh itself.
 void runPlanMesh(const PlanOptions& options, MeshJob job) {
-  const std::string& path = options.surface.input;
+  const std::string path = sourceName(options.surface);  // "<stdin>" for "-"
   const char* const what = job.part ? "a tessellated part" : "a mesh";
   rejectMeshOptions(options, what);
   auto progress = [&](const std::string& line) {
@@ -387,6 +387,19 @@ MeshJob tessellatedJob(const PlanOptions& options, const CadPart& part, const st
                                 "at {} points)",
                                 mesh.mesh.triangles.size(), part.faces(), cadFormatName(part.format()), mesh.deviation,
                                 unitsName(part.units()), mesh.deviationSamples);
+  // The clearance is material left on the part: beside H it shows in the scallops. Often it is
+  // not the mesh but the model: faces whose edges stand off their surfaces by the model's
+  // tolerance (OCCT's bearing.iges: 0.0012 mm).
+  const double height = options.scallopHeight.empty() ? (inch ? 0.001 : 0.025)
+                                                      : parsePositive(options.scallopHeight, "scallop height",
+                                                                      "a positive length");
+  if (options.spacing.empty() && job.clearance > 0.5 * height && !options.quiet)
+    fmt::print(stderr,
+               "scallop plan: warning: the exact faces stand up to {:.3g} {} from the mesh (face {}, near ({:.6g}, "
+               "{:.6g}, {:.6g})), and the passes keep 1.5 times that farther: beside H = {} the scallops will show "
+               "it (a smaller --deflection helps unless the model's own tolerance is the cause)\n",
+               mesh.deviation, unitsName(part.units()), mesh.deviationFace, mesh.deviationAt.x, mesh.deviationAt.y,
+               mesh.deviationAt.z, height);
   job.tessellation = TessellationSummary{part.faces(), mesh.mesh.triangles.size(), deflection, mesh.deviation,
                                          mesh.deviationFace, job.clearance, false};
   job.mesh = std::move(mesh.mesh);
@@ -396,7 +409,7 @@ MeshJob tessellatedJob(const PlanOptions& options, const CadPart& part, const st
 void runPlan(const PlanOptions& options) {
   if (!options.spacing.empty() && !options.scallopHeight.empty())
     throw CLI::ValidationError("plan", "give at most one of --spacing and --scallop-height");
-  if (isStlPath(options.surface.input)) {
+  if (isStlSource(options.surface.input)) {
     if (options.tessellate || !options.deflection.empty())
       throw Error(fmt::format("{}: --tessellate and --deflection are for STEP and IGES parts; an STL file is a mesh "
                               "already",

@@ -3,6 +3,8 @@
 #include <cctype>
 #include <cstddef>
 #include <cstdio>
+#include <filesystem>
+#include <system_error>
 #include <map>
 #include <optional>
 #include <string_view>
@@ -102,15 +104,25 @@ Surface loadSurface(const SurfaceSource& source, bool announce) {
       source.example.empty() ? cadFormatOf(source.input) : std::optional<CadFormat>();
   if (source.skipFaces && !cad)
     throw Error(fmt::format("{}: --skip-faces is for STEP and IGES files", sourceBaseName(source)));
+  // Standard input is read once (a command may have looked at it): JSON when its first
+  // non-blank character is '{', .bpt otherwise, as readSurface tells them apart.
+  const auto read = [&](SurfaceCheck check) {
+    if (source.input != "-") return readSurface(source.input, check);
+    std::string_view text = standardInput();
+    if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);
+    const std::size_t first = text.find_first_not_of(" \t\r\n\f\v");
+    return first != std::string_view::npos && text[first] == '{' ? parseSurface(standardInput(), "-", check)
+                                                                  : parseBptSurface(standardInput(), "-", check);
+  };
   if (source.patches.empty()) {
     if (cad) return importCadSurface(source, *cad, announce);
-    return source.example.empty() ? readSurface(source.input) : exampleSurface(source.example);
+    return source.example.empty() ? read(SurfaceCheck::full) : exampleSurface(source.example);
   }
   const std::string name = sourceBaseName(source);
   // Examples are built, not read: they are not validated (as without --patches). A CAD
   // import validates every patch it returns.
   const Surface whole = cad ? importCadSurface(source, *cad, announce)
-                        : source.example.empty() ? readSurface(source.input, SurfaceCheck::formOnly)
+                        : source.example.empty() ? read(SurfaceCheck::formOnly)
                                                  : exampleSurface(source.example);
   std::vector<std::size_t> indices;
   try {
@@ -152,11 +164,43 @@ bool isStlPath(const std::string& path) {
   return tail == ".stl";
 }
 
+const std::string& standardInput() {
+  static const std::string bytes = [] {
+    std::string content;
+    char buffer[1 << 16];
+    std::size_t count = 0;
+    while ((count = std::fread(buffer, 1, sizeof buffer, stdin)) > 0) content.append(buffer, count);
+    if (std::ferror(stdin) != 0) throw Error("cannot read standard input");
+    return content;
+  }();
+  return bytes;
+}
+
+bool isStlSource(const std::string& path) {
+  if (path.empty()) return false;
+  if (path == "-") return looksLikeStl(standardInput(), standardInput().size());
+  if (isStlPath(path)) return true;
+  std::string lower = path;
+  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  for (const std::string_view known : {".json", ".bpt", ".step", ".stp", ".iges", ".igs"})
+    if (lower.ends_with(known)) return false;
+  std::error_code error;
+  const std::uintmax_t size = std::filesystem::file_size(path, error);
+  if (error) return false;  // the reader that follows names the problem
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (file == nullptr) return false;
+  char head[256];
+  const std::size_t count = std::fread(head, 1, sizeof head, file);
+  std::fclose(file);
+  return looksLikeStl(std::string_view(head, count), size);
+}
+
 StlMesh loadStlMesh(const std::string& path, const std::string& units, bool dropZeroArea) {
   StlOptions stl;
   stl.units = units == "in" ? Units::inch : Units::millimetre;
   stl.dropZeroArea = dropZeroArea;
   try {
+    if (path == "-") return parseStl(standardInput(), "<stdin>", stl);
     return readStl(path, stl);
   } catch (const Error& e) {
     if (!dropZeroArea && std::string(e.what()).find("zero area") != std::string::npos)

@@ -53,8 +53,18 @@ std::string sourceName(const SurfaceSource& source);
 /// A mesh by its name: .stl in any case.
 bool isStlPath(const std::string& path);
 
-/// The STL mesh at `path` in `units` ("in" or "mm"; empty: mm, STL has none); zero-area
-/// triangles refused (the message then names --drop-zero-area) unless `dropZeroArea`.
+/// Standard input's bytes, read once on first use: a command looks at them (is it STL?)
+/// before it parses them. scallop::Error when it cannot be read.
+const std::string& standardInput();
+
+/// Whether the surface argument is an STL mesh: by its name (.stl); a name that is none of
+/// scallop's other forms (.json, .bpt, .step, .stp, .iges, .igs), and standard input ("-"),
+/// by content (mesh.hpp's looksLikeStl).
+bool isStlSource(const std::string& path);
+
+/// The STL mesh at `path` ("-": standard input) in `units` ("in" or "mm"; empty: mm, STL has
+/// none); zero-area triangles refused (the message then names --drop-zero-area) unless
+/// `dropZeroArea`.
 StlMesh loadStlMesh(const std::string& path, const std::string& units, bool dropZeroArea);
 
 /// --units in|mm and --drop-zero-area, for commands that take an STL mesh.

@@ -63,7 +63,7 @@ int runVerify(const VerifyOptions& options) {
   SimulationOptions simulation;
   simulation.toolRadius = parsePositive(options.radius, "tool radius", "a positive length");
   // The design: a triangle mesh (.stl) or a surface of Bezier patches.
-  const bool mesh = expected == 2 && isStlPath(source.input);
+  const bool mesh = expected == 2 && isStlSource(source.input);
   if (mesh && (!options.patches.empty() || options.skipFaces))
     throw Error(fmt::format("{}: --patches and --skip-faces select a surface's patches or faces; not for a mesh",
                             source.input));
@@ -83,9 +83,15 @@ int runVerify(const VerifyOptions& options) {
       throw Error(fmt::format("{}: --patches selects Bezier patches; give --skip-faces to judge only the faces "
                               "imported exactly",
                               source.input));
-    if (part->exactFaces().skipped.empty()) {
+    const CadImport exact = part->exactFaces();
+    if (exact.skipped.empty()) {
       part.reset();
       surface = loadSurface(source);
+    } else if (options.jsonPath != kStandardStream) {
+      fmt::print(stderr,
+                 "scallop: {}: {} of {} faces cannot be imported as exact Bezier patches yet (the first: {}): the "
+                 "program is judged on the exact faces through OpenCASCADE (vertical lines through each grid point)\n",
+                 source.input, exact.skipped.size(), part->faces(), exact.skipped.front().reason);
     }
   } else {
     surface = loadSurface(source);

@@ -118,7 +118,8 @@ CadPart::CadPart(const std::string& path, CadFormat format) : impl_(std::make_un
                             impl_->file.roots));
   Bnd_Box box;
   try {
-    BRepBndLib::Add(impl_->file.shape, box);
+    // The tight box (AddOptimal): Add bounds a trimmed face by its whole surface's poles.
+    BRepBndLib::AddOptimal(impl_->file.shape, box, Standard_False, Standard_False);
   } catch (const Standard_Failure& failure) {
     throw Error(fmt::format("{}: OpenCASCADE failed to bound the part ({})", path, detail::occtMessage(failure)));
   }

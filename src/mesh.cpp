@@ -253,6 +253,18 @@ StlMesh parseStl(std::string_view bytes, const std::string& sourceName, const St
   return out;
 }
 
+bool looksLikeStl(std::string_view head, std::uint64_t size) {
+  if (head.size() >= kHeaderBytes + 4 &&
+      size == kHeaderBytes + 4 + static_cast<std::uint64_t>(kTriangleBytes) * littleEndian32(head.data() + kHeaderBytes))
+    return true;
+  if (head.substr(0, 3) == "\xEF\xBB\xBF") head.remove_prefix(3);
+  std::size_t first = 0;
+  while (first < head.size() && std::isspace(static_cast<unsigned char>(head[first]))) ++first;
+  head.remove_prefix(first);
+  return head.size() >= 5 && AsciiReader::same(head.substr(0, 5), "solid") &&
+         (head.size() == 5 || std::isspace(static_cast<unsigned char>(head[5])));
+}
+
 StlMesh readStl(const std::string& path, const StlOptions& options) {
   const std::string bytes = detail::readInputFile(path);
   return parseStl(bytes, path == "-" ? "<stdin>" : path, options);

@@ -230,6 +230,21 @@ TEST_F(PathsCli, PlanCutsAnStlMeshByRaster) {
         << refused.err;
     EXPECT_FALSE(fs::exists(workDir_ / "x"));
   }
+  // The same mesh by its content: on standard input and under a name without .stl. The same
+  // program but for its title line, which names the source.
+  const auto body = [](const std::string& program) { return program.substr(program.find('\n')); };
+  const std::string program = readFile(workDir_ / "m" / "toolpath.ngc");
+  const RunResult piped = run("plan - --units in --tool-radius 0.25 --scallop-height 0.001 --out p --quiet",
+                              (workDir_ / "paper1.stl").string());
+  ASSERT_EQ(piped.exitCode, 0) << piped.err;
+  EXPECT_EQ(body(readFile(workDir_ / "p" / "toolpath.ngc")), body(program));
+  EXPECT_NE(readFile(workDir_ / "p" / "report.json").find("\"source\": \"<stdin>\""), std::string::npos);
+  fs::copy_file(workDir_ / "paper1.stl", workDir_ / "paper1.mesh");
+  const RunResult named = run("plan paper1.mesh --units in --tool-radius 0.25 --scallop-height 0.001 --out n --quiet");
+  ASSERT_EQ(named.exitCode, 0) << named.err;
+  EXPECT_EQ(body(readFile(workDir_ / "n" / "toolpath.ngc")), body(program));
+  const RunResult verified = run("verify paper1.mesh m/toolpath.ngc --units in --radius 0.25 --fail-on-gouge");
+  EXPECT_EQ(verified.exitCode, 0) << verified.err;
 }
 
 // A plate at z = 0 over a hidden pyramid reaching down to z = -20 (mm), as OpenCAMLib's

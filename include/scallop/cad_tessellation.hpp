@@ -107,7 +107,7 @@ class CadPart {
   Units units() const;
   const std::string& fileUnit() const;  ///< as the file names it ("INCH", "MM")
   std::size_t faces() const;
-  Vec3 boxLow() const;   ///< the part's bounding box (OCCT's, slightly enlarged by its tolerances)
+  Vec3 boxLow() const;   ///< the part's bounding box (OCCT's BRepBndLib::AddOptimal, without tolerances)
   Vec3 boxHigh() const;
 
   /// The faces cad_import.hpp converts to exact Bezier patches, and those it cannot (as

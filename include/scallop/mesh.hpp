@@ -71,6 +71,14 @@ struct StlMesh {
 /// See the contract.
 StlMesh parseStl(std::string_view bytes, const std::string& sourceName, const StlOptions& options);
 
+/// Whether bytes are STL by their content, as parseStl tells the forms apart: the size of a
+/// binary STL (exactly 84 + 50 n for the count n at byte 80; `size` is the whole file's, `head`
+/// its first bytes, at least 84 of them when there are), or text that begins, past blanks and a
+/// UTF-8 byte order mark, with "solid" (any case) and a blank or its end. A surface's JSON
+/// begins with '{' and .bpt with a number; text's bytes 80-83 would count more than 500 million
+/// triangles, which no text file of that size holds.
+bool looksLikeStl(std::string_view head, std::uint64_t size);
+
 /// parseStl on the whole file at `path` ("-": standard input).
 StlMesh readStl(const std::string& path, const StlOptions& options);
 
