@@ -76,6 +76,7 @@ struct MeshJob {
   Mesh mesh;
   std::string description;        // the progress line's "4,608 triangles (binary STL)"
   double clearance = 0.0;         // added to R in every proof: the tessellation's margin
+  double deviation = 0.0;         // the exact faces' sampled distance from the mesh
   const CadPart* part = nullptr;  // the exact faces: the simulated cut's design
   std::optional<TessellationSummary> tessellation;
 };
@@ -182,7 +183,9 @@ void runPlanMesh(const PlanOptions& options, MeshJob job) {
                                            : parsePositive(options.scallopHeight, "scallop height", "a positive length");
     if (!(*height < radius))
       throw Error(fmt::format("the scallop height {} must be smaller than the tool radius {}", *height, radius));
-    spacing = meshRasterSpacing(radius, *height);
+    // A tessellated part's passes stand the clearance off the mesh, which stands up to the
+    // deviation off the exact faces: the cusps aim at what is left of H (at least H / 4).
+    spacing = meshRasterSpacing(radius, std::max(*height - job.clearance - job.deviation, 0.25 * *height));
   }
   const double rapidRate = options.rapidRate.empty()
                                ? defaultRapidRate(mesh.units)
@@ -212,9 +215,11 @@ void runPlanMesh(const PlanOptions& options, MeshJob job) {
   raster.spacing = spacing;
   // A chord of the drop line leaves at most its sag of material: a quarter of H, as the
   // surfaces' sag rule (envelope.hpp).
-  if (height) raster.sagTolerance = *height / 4.0;
+  const std::optional<double> cuspHeight =
+      height ? std::optional<double>(std::max(*height - job.clearance - job.deviation, 0.25 * *height)) : std::nullopt;
+  if (cuspHeight) raster.sagTolerance = *cuspHeight / 4.0;
   // With H, the steps between lines adapt to the facets' slopes (mesh_raster.hpp).
-  if (height) raster.scallopHeight = *height;
+  if (cuspHeight) raster.scallopHeight = *cuspHeight;
   // Off the part the ball runs R above the lowest point seen from above (the simulation's
   // design, exact at its grid points), never beside the part below what it shows.
   SimulationOptions simulation;
@@ -301,7 +306,7 @@ void runPlanMesh(const PlanOptions& options, MeshJob job) {
         return verifyProgram(
             mesh.units, std::move(grid), top,
             [&part](HeightGrid& g, std::vector<double>& normalZ) { part.designHeights(g, &normalZ); }, written,
-            simulation);
+            simulation, &mesh);
       }
       progress(fmt::format("the simulation's {} x {} grid exceeds the budget of {} lines through the exact faces: "
                            "simulating the cut on the mesh",
@@ -323,7 +328,7 @@ void runPlanMesh(const PlanOptions& options, MeshJob job) {
   fmt::print(stderr,
              "scallop plan: raster on {}{}: {} triangles, {} lines {:.5g} to {:.5g} {} apart, tool-centre length {:.4f} {}, "
              "{} moves proven within eps {:.2g} ({} unproven), deepest ball interference {:.6f} {} (exact); {}; "
-             "simulated: gouge {:.6f}, scallop max {:.6f} / 99% {:.6f} {}{}; {:.2f} s -> {}/\n",
+             "simulated: gouge {:.6f}, scallop max {:.6f} / 99% {:.6f} {}{}{}; {:.2f} s -> {}/\n",
              path,
              job.tessellation
                  ? fmt::format(" (tessellated: deviation {:.3g} {}, clearance {:.3g}; simulated on the {})",
@@ -335,9 +340,13 @@ void runPlanMesh(const PlanOptions& options, MeshJob job) {
              gouge.maxDepth, units, cycleSummary(report, mesh.units), simulated.maxGouge, simulated.maxScallop,
              simulated.scallopP99, units,
              height && simulated.maxScallop > *height
-                 ? fmt::format(" (above H = {} on {:.4g} {}^2: the facets' cusps are modelled, not the edges between them "
-                               "nor what a ball cannot reach)",
+                 ? fmt::format(" (above H = {} on {:.4g} {}^2: the facets' cusps are modelled, not the edges between "
+                               "them)",
                                *height, simulated.uncutArea, units)
+                 : std::string(),
+             simulated.unreachablePoints > 0
+                 ? fmt::format(", {:.4g} {}^2 beyond the ball's reach (up to {:.4g} {} left)", simulated.unreachableArea,
+                               units, simulated.maxUnreachableScallop, units)
                  : std::string(),
              report.seconds, options.out);
 }
@@ -393,11 +402,13 @@ MeshJob tessellatedJob(const PlanOptions& options, const CadPart& part, const st
   const double height = options.scallopHeight.empty() ? (inch ? 0.001 : 0.025)
                                                       : parsePositive(options.scallopHeight, "scallop height",
                                                                       "a positive length");
-  if (options.spacing.empty() && job.clearance > 0.5 * height && !options.quiet)
+  job.deviation = mesh.deviation;
+  if (options.spacing.empty() && job.clearance + job.deviation > 0.75 * height && !options.quiet)
     fmt::print(stderr,
                "scallop plan: warning: the exact faces stand up to {:.3g} {} from the mesh (face {}, near ({:.6g}, "
-               "{:.6g}, {:.6g})), and the passes keep 1.5 times that farther: beside H = {} the scallops will show "
-               "it (a smaller --deflection helps unless the model's own tolerance is the cause)\n",
+               "{:.6g}, {:.6g})), and the passes keep 1.5 times that farther: that leaves more than 3/4 of H = {}, "
+               "so the scallops will exceed H (a smaller --deflection helps unless the model's own tolerance is the "
+               "cause)\n",
                mesh.deviation, unitsName(part.units()), mesh.deviationFace, mesh.deviationAt.x, mesh.deviationAt.y,
                mesh.deviationAt.z, height);
   job.tessellation = TessellationSummary{part.faces(), mesh.mesh.triangles.size(), deflection, mesh.deviation,

@@ -4,6 +4,7 @@
 // or nothing. Exit status: 0, also when the program gouges, unless --fail-on-gouge is given
 // and the deepest gouge exceeds the tolerance: then 2 (after writing the outputs). Errors 1.
 
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 #include <optional>
@@ -119,10 +120,15 @@ int runVerify(const VerifyOptions& options) {
     if (!part) return verifyProgram(*surface, program, simulation);
     const Vec3 low = part->boxLow(), high = part->boxHigh();
     const CadPart& exact = *part;
+    // Reach is classified on a tessellation (the normal and the drop envelope from its
+    // triangles, as on an STL mesh): at H / 8, no finer than 1e-5 of the part's size.
+    TessellationOptions tessellation;
+    tessellation.deflection = std::max(simulation.scallopHeight / 8.0, 1e-5 * norm(high - low));
+    const Mesh facets = exact.tessellate(tessellation).mesh;
     return verifyProgram(
         exact.units(), simulationGrid(Vec2{low.x, low.y}, Vec2{high.x, high.y}, simulation), high.z,
         [&exact](HeightGrid& grid, std::vector<double>& normalZ) { exact.designHeights(grid, &normalZ); }, program,
-        simulation);
+        simulation, &facets);
   }();
   const VerifySources sources{sourceName(source), program.sourceName == "-" ? "<stdin>" : program.sourceName,
                               program.unknownStartMoves, program.maxArcRadiusMismatch};

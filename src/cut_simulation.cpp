@@ -4,6 +4,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <limits>
@@ -21,6 +22,8 @@
 #include "scallop/envelope.hpp"
 #include "scallop/error.hpp"
 #include "scallop/gouge.hpp"
+#include "scallop/mesh.hpp"
+#include "scallop/mesh_drop.hpp"
 #include "scallop/surface.hpp"
 
 namespace scallop {
@@ -522,9 +525,17 @@ void designHeights(const Surface& surface, HeightGrid& grid, std::vector<double>
   }
 }
 
-void designHeights(const Mesh& mesh, HeightGrid& grid, std::vector<double>* normalZ) {
+namespace {
+
+constexpr std::uint32_t kNoTriangle = std::numeric_limits<std::uint32_t>::max();
+
+// designHeights on a mesh, with the winning triangle per point (kNoTriangle where none) when
+// `triangles` is given.
+void meshDesign(const Mesh& mesh, HeightGrid& grid, std::vector<double>* normalZ,
+                std::vector<std::uint32_t>* triangles) {
   std::fill(grid.z.begin(), grid.z.end(), -kInf);
   if (normalZ) normalZ->assign(grid.z.size(), 0.0);
+  if (triangles) triangles->assign(grid.z.size(), kNoTriangle);
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
     const auto& tri = mesh.triangles[t];
     const Vec3 a = mesh.vertices[tri[0]], b = mesh.vertices[tri[1]], c = mesh.vertices[tri[2]];
@@ -554,10 +565,17 @@ void designHeights(const Mesh& mesh, HeightGrid& grid, std::vector<double>* norm
         if (z > top) {
           top = z;
           if (normalZ) (*normalZ)[j * grid.columns + i] = nz;
+          if (triangles) (*triangles)[j * grid.columns + i] = static_cast<std::uint32_t>(t);
         }
       }
     }
   }
+}
+
+}  // namespace
+
+void designHeights(const Mesh& mesh, HeightGrid& grid, std::vector<double>* normalZ) {
+  meshDesign(mesh, grid, normalZ, nullptr);
 }
 
 // The grid points within R (horizontally) of a move's box: the only ones it can lower.
@@ -615,6 +633,31 @@ using ReachTest = std::function<bool(Vec3)>;
 // of the simulations that leave none): makes a ReachTest per thread. None: no classification.
 using ReachPreparation = std::function<std::function<ReachTest()>()>;
 
+// The contract's Reach on a mesh: q's upward normal is that of the triangle that holds q over
+// its grid point (`triangles`, from meshDesign on `grid`), the drop envelope is the exact one
+// of MeshDropCutter (built when first needed, shared by the threads: its queries are const).
+ReachPreparation meshReach(const Mesh& mesh, const HeightGrid& grid,
+                           std::shared_ptr<const std::vector<std::uint32_t>> triangles, double radius, double height) {
+  return [&mesh, &grid, triangles, radius, height]() -> std::function<ReachTest()> {
+    const auto cutter = std::make_shared<const MeshDropCutter>(mesh, radius);
+    return [&mesh, &grid, triangles, cutter, radius, height]() -> ReachTest {
+      return [&mesh, &grid, triangles, cutter, radius, height](Vec3 q) {
+        const auto i = static_cast<std::size_t>(std::llround((q.x - grid.x0) / grid.spacing));
+        const auto j = static_cast<std::size_t>(std::llround((q.y - grid.y0) / grid.spacing));
+        const std::uint32_t t = (*triangles)[j * grid.columns + i];
+        if (t == kNoTriangle) return false;
+        Vec3 n = triangleNormal(mesh, t);
+        if (n.z < 0.0) n = -n;
+        const Vec3 c = q + radius * n;
+        const double z = cutter->drop(c.x, c.y).z;
+        if (!std::isfinite(z)) return false;
+        const double lift = std::max(0.0, z - c.z);
+        return std::sqrt(radius * radius + 2.0 * radius * lift * n.z + lift * lift) - radius > height;
+      };
+    };
+  };
+}
+
 // A report's figures before the design: units, tool, grid, tolerances, the stock's top.
 SimulationReport reportFor(Units units, HeightGrid grid, double highest, const SimulationOptions& options) {
   SimulationReport report;
@@ -665,14 +708,17 @@ SimulationReport simulateCut(const Mesh& mesh, const std::vector<SweptMove>& mov
   double top = -kInf;
   for (const Vec3& v : mesh.vertices) top = std::max(top, v.z);
   SimulationReport report = reportFor(mesh.units, simulationGrid(mesh, options), top, options);
-  designHeights(mesh, report.design, &report.designNormalZ);
+  auto triangles = std::make_shared<std::vector<std::uint32_t>>();
+  meshDesign(mesh, report.design, &report.designNormalZ, triangles.get());
   report.designSeconds = secondsSince(start);
-  sweepAndCompare(report, moves, options, nullptr, start);
+  sweepAndCompare(report, moves, options,
+                  meshReach(mesh, report.design, triangles, options.toolRadius, options.scallopHeight), start);
   return report;
 }
 
 SimulationReport simulateCut(Units units, HeightGrid grid, double highest, const DesignHeightsFunction& design,
-                             const std::vector<SweptMove>& moves, const SimulationOptions& options) {
+                             const std::vector<SweptMove>& moves, const SimulationOptions& options,
+                             const Mesh* reachMesh) {
   const auto start = std::chrono::steady_clock::now();
   validateOptions(options);
   SimulationReport report = reportFor(units, std::move(grid), highest, options);
@@ -682,7 +728,15 @@ SimulationReport simulateCut(Units units, HeightGrid grid, double highest, const
   if (report.designNormalZ.size() != report.design.z.size())
     throw Error("the design's normals do not match its grid");  // a caller's bug, not the input's
   report.designSeconds = secondsSince(start);
-  sweepAndCompare(report, moves, options, nullptr, start);
+  ReachPreparation reach;
+  if (reachMesh) {
+    // The triangles over the grid's points: q's normal and the drop come from the mesh.
+    auto triangles = std::make_shared<std::vector<std::uint32_t>>();
+    HeightGrid meshGrid = report.design;
+    meshDesign(*reachMesh, meshGrid, nullptr, triangles.get());
+    reach = meshReach(*reachMesh, report.design, triangles, options.toolRadius, options.scallopHeight);
+  }
+  sweepAndCompare(report, moves, options, reach, start);
   return report;
 }
 
@@ -848,10 +902,11 @@ SimulationReport verifyProgram(const Mesh& mesh, const GcodeProgram& program, co
 }
 
 SimulationReport verifyProgram(Units units, HeightGrid grid, double highest, const DesignHeightsFunction& design,
-                               const GcodeProgram& program, const SimulationOptions& options) {
+                               const GcodeProgram& program, const SimulationOptions& options, const Mesh* reachMesh) {
   requireUnits(program, units, "part");
   validateOptions(options);
-  return simulateCut(units, std::move(grid), highest, design, sweptMoves(program, options.toolRadius), options);
+  return simulateCut(units, std::move(grid), highest, design, sweptMoves(program, options.toolRadius), options,
+                     reachMesh);
 }
 
 SimulationReport verifyToolPath(const Surface& surface, const ToolPath& path, SimulationOptions options) {

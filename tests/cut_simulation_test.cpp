@@ -1185,8 +1185,52 @@ TEST(CutSimulationMesh, APlaneAsTrianglesIsCutAsThePlanePatchIs) {
   EXPECT_NEAR(onMesh.maxGouge, onPatch.maxGouge, 1e-12);
   EXPECT_EQ(onMesh.uncutPoints, onPatch.uncutPoints);
   EXPECT_GT(onMesh.maxScallop, 0.0);
-  // No reach classification on meshes yet: nothing counted beyond reach.
-  EXPECT_EQ(onMesh.unreachablePoints, 0u);
+}
+
+// Reach on a mesh: a plate z = 0 over [0, 4] x [0, 2] in with a slot 0.4 in wide and 0.5 deep
+// along y (floor z = -0.5 over 1.8 < x < 2.2, vertical walls), finishing stock 0.05 in, no
+// move: every point stays 0.05 > H above the design. In closed form a ball of R = 0.5 cannot
+// enter the slot: over its middle its centre stops on both rims at sqrt(R^2 - 0.2^2) =
+// 0.458 in, so it stays 0.458 - 0.5 + 0.5 = 0.458 in above the floor, and nearer the walls
+// more (the rim it rests on is nearer): every floor point is beyond reach, by far. On the
+// plate the ball sits on the plate: every plate point is reachable.
+TEST(CutSimulationMesh, ASlotNarrowerThanTheBallIsBeyondReachThePlateIsNot) {
+  Mesh mesh;
+  mesh.units = Units::inch;
+  const auto quad = [&](Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
+    const auto at = static_cast<std::uint32_t>(mesh.vertices.size());
+    mesh.vertices.insert(mesh.vertices.end(), {a, b, c, d});
+    mesh.triangles.push_back({at, at + 1, at + 2});
+    mesh.triangles.push_back({at, at + 2, at + 3});
+  };
+  quad({0, 0, 0}, {1.8, 0, 0}, {1.8, 2, 0}, {0, 2, 0});                  // plate, left
+  quad({2.2, 0, 0}, {4, 0, 0}, {4, 2, 0}, {2.2, 2, 0});                  // plate, right
+  quad({1.8, 0, -0.5}, {2.2, 0, -0.5}, {2.2, 2, -0.5}, {1.8, 2, -0.5});  // floor
+  quad({1.8, 0, 0}, {1.8, 0, -0.5}, {1.8, 2, -0.5}, {1.8, 2, 0});        // walls
+  quad({2.2, 0, -0.5}, {2.2, 0, 0}, {2.2, 2, 0}, {2.2, 2, -0.5});
+  SimulationOptions options;
+  options.toolRadius = 0.5;
+  options.scallopHeight = 0.01;
+  options.resolution = 0.0237;
+  options.stockAllowance = 0.05;
+  options.stockTop = 1.0;  // above the plate's allowance (the default, the mesh's top, would clip it)
+  const SimulationReport report = simulateCut(mesh, {}, options);
+  expectReachBookkeeping(report, options.scallopHeight, "slot");
+  std::size_t floor = 0, plate = 0;
+  for (std::size_t j = 0; j < report.design.rows; ++j)
+    for (std::size_t i = 0; i < report.design.columns; ++i) {
+      const std::size_t index = j * report.design.columns + i;
+      const Vec2 p = report.design.point(i, j);
+      if (report.design.z[index] == -kInf) continue;
+      if (std::abs(p.x - 1.8) < 1e-9 || std::abs(p.x - 2.2) < 1e-9) continue;  // the rims: either answer
+      const bool inSlot = p.x > 1.8 && p.x < 2.2;
+      EXPECT_EQ(report.unreachable[index], inSlot ? 1 : 0) << "(" << p.x << ", " << p.y << ")";
+      (inSlot ? floor : plate) += 1;
+    }
+  EXPECT_GT(floor, 1000u);
+  EXPECT_GT(plate, 10000u);
+  EXPECT_NEAR(report.maxUnreachableScallop, 0.05, 1e-12);
+  EXPECT_EQ(report.uncutPoints, plate);  // the plate, reachable, still carries its 0.05
 }
 
 TEST(CutSimulationMesh, BadInput) {

@@ -92,8 +92,10 @@
 //         it, exactly (barycentric coordinates in the xy projection, each >= -1e-12 so that a
 //         point on an edge belongs to both triangles and to the footprint despite rounding;
 //         vertical triangles show only through their neighbours), |n_z| the winning
-//         triangle's; no reach classification yet (every point counts in the scallop
-//         figures). The sweep and the comparison are the same.
+//         triangle's. Reach as above with n the winning triangle's upward unit normal and the
+//         drop envelope mesh_drop.hpp's exact MeshDropCutter (at a concave crease between
+//         facets a ball leaves material whatever its radius: such points above H count as
+//         unreachable). The sweep and the comparison are the same.
 // Cost:   O(P + sum over moves of the grid points within R of the move's box) time,
 //         O(P) memory, P the grid points; the design O(P) Newton solves of a few steps.
 // Errors: scallop::Error for invalid options (naming the option and value), non-finite
@@ -283,9 +285,11 @@ SimulationReport simulateCut(const Mesh& mesh, const std::vector<SweptMove>& mov
 
 /// The whole simulation on `grid` (from simulationGrid, heights -infinity) with the design
 /// from `design`; `highest` is the part's highest point (the default stock top). Points left
-/// above H are not classified by reach (as on a mesh).
+/// above H are classified by reach on `reachMesh` (the part's tessellation: the normal and the
+/// drop envelope from the mesh, as the contract's Meshes), or not at all without one.
 SimulationReport simulateCut(Units units, HeightGrid grid, double highest, const DesignHeightsFunction& design,
-                             const std::vector<SweptMove>& moves, const SimulationOptions& options);
+                             const std::vector<SweptMove>& moves, const SimulationOptions& options,
+                             const Mesh* reachMesh = nullptr);
 
 /// simulateCut on a program (its units must be the surface's).
 SimulationReport verifyProgram(const Surface& surface, const GcodeProgram& program,
@@ -296,7 +300,8 @@ SimulationReport verifyProgram(const Mesh& mesh, const GcodeProgram& program, co
 
 /// simulateCut on a program with the design from `design` (the program's units must be `units`).
 SimulationReport verifyProgram(Units units, HeightGrid grid, double highest, const DesignHeightsFunction& design,
-                               const GcodeProgram& program, const SimulationOptions& options);
+                               const GcodeProgram& program, const SimulationOptions& options,
+                               const Mesh* reachMesh = nullptr);
 
 /// simulateCut on a tool path (options.toolRadius 0 takes path.toolRadius).
 SimulationReport verifyToolPath(const Surface& surface, const ToolPath& path, SimulationOptions options);
