@@ -226,7 +226,7 @@ MeshJob tessellatedJob(const CadPart& part, const std::optional<CadImport>& exac
     fmt::print(stderr,
                "scallop {}: warning: the exact faces stand up to {:.3g} {} from the mesh (face {}, near ({:.6g}, "
                "{:.6g}, {:.6g})), and the passes keep 1.5 times that farther: that leaves more than 3/4 of H = {}, "
-               "so the scallops will exceed H (a smaller --deflection helps unless the model's own tolerance is the "
+               "so the scallops may exceed H (a smaller --deflection helps unless the model's own tolerance is the "
                "cause)\n",
                options.command, mesh.deviation, unitsName(part.units()), mesh.deviationFace, mesh.deviationAt.x, mesh.deviationAt.y,
                mesh.deviationAt.z, height);

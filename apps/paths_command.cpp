@@ -3,6 +3,7 @@
 // each section's tool path from the scallop hull's offset), as JSON, G-code and/or a figure.
 // Every output is computed first and the files are written all or nothing.
 
+#include <chrono>
 #include <cstdio>
 #include <memory>
 #include <optional>
@@ -15,12 +16,14 @@
 #include "arguments.hpp"
 #include "commands.hpp"
 #include "output_directory.hpp"
+#include "scallop/cad_tessellation.hpp"
 #include "scallop/error.hpp"
 #include "scallop/gcode.hpp"
 #include "scallop/paths_output.hpp"
 #include "scallop/surface.hpp"
 #include "surface_options.hpp"
 #include "linking_options.hpp"
+#include "mesh_job.hpp"
 #include "toolpath_job.hpp"
 
 namespace scallop::cli {
@@ -33,7 +36,7 @@ struct PathsOptions {
   std::string toolRadius;
   std::string spacing;
   std::string scallopHeight;
-  std::string strategy = "contour";
+  std::string strategy;  // empty: contour for a surface, raster for a mesh
   std::string normal = "auto";
   std::string angle;
   std::string dialect = "linuxcnc";
@@ -46,18 +49,118 @@ struct PathsOptions {
   bool noDropEnvelope = false;
   bool oneWay = false;
   bool constantSpacing = false;
+  std::string units;          // --units in|mm: an STL mesh's
+  bool dropZeroArea = false;  // --drop-zero-area: an STL mesh's
+  bool tessellate = false;    // --tessellate: a STEP/IGES part cut through its tessellation
+  std::string deflection;     // --deflection D: that tessellation's
 };
+
+// `paths` on a triangle mesh (an STL file, or a STEP/IGES part's tessellation): the raster of
+// exact drop lines (mesh_job.hpp), every move proven, as JSON and G-code.
+void runPathsMesh(const PathsOptions& options, const MeshJob& job) {
+  const std::string source = sourceName(options.surface);
+  const char* const what = job.part ? "a tessellated part" : "a mesh";
+  const auto reject = [&](bool given, const char* option, const char* why) {
+    if (given) throw Error(fmt::format("{}: {} {}; not for {}", source, option, why, what));
+  };
+  reject(options.strategy == "contour", "--strategy contour",
+         "needs the surface's normal along its sections (a mesh's jumps at every edge): meshes are cut by raster");
+  reject(!options.surface.patches.empty(), "--patches", "selects a surface's patches");
+  reject(options.normal != "auto", "--normal", "is the contour strategy's");
+  reject(!options.angle.empty(), "--angle", "turns a surface's raster (a mesh's runs along x)");
+  reject(options.noDropEnvelope, "--no-drop-envelope", "keeps a surface strategy's own centres (a mesh's passes are drop lines)");
+  reject(options.constantSpacing, "--constant-spacing", "is the optimal planes' flat-surface spacing");
+  reject(options.noLinking || options.oneWay, "--no-linking/--one-way", "order a surface plan's passes (a mesh's raster is one zigzag)");
+  reject(options.noGougeCheck, "--no-gouge-check", "skips a surface's sampled check (a mesh's moves are all proven exactly)");
+  reject(!options.svgPath.empty(), "--svg", "draws a surface's sections (scallop plan draws a mesh's simulated cut)");
+  MeshRasterRequest request;
+  request.source = source;
+  request.command = "paths";
+  request.toolRadius = options.toolRadius;
+  request.scallopHeight = options.scallopHeight;
+  request.spacing = options.spacing;
+  request.quiet = true;
+  MeshRasterResult raster = runMeshRaster(job, request);
+  const Units units = job.mesh.units;
+  const double rapidRate = options.rapidRate.empty()
+                               ? defaultRapidRate(units)
+                               : parsePositive(options.rapidRate, "rapid rate", "a positive rate");
+  const GcodeDialect dialect = gcodeDialect(options.dialect);
+  const GcodeOptions gcodeOptions =
+      defaultGcodeOptions(units, raster.top, raster.paths.path, dialect, fmt::format("scallop paths raster {}", source));
+  PathsReport& report = raster.report;
+  report.motion = gcodeMotion(raster.paths.path, gcodeOptions, rapidRate);
+  report.feedRate = gcodeOptions.feedRate;
+  report.plungeFeedRate = gcodeOptions.plungeFeedRate;
+  report.rapidRate = rapidRate;
+  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - raster.start).count();
+  std::vector<OutputFile> outputs;
+  const bool anyOutput = !options.jsonPath.empty() || !options.gcodePath.empty();
+  const std::string jsonPath = anyOutput ? options.jsonPath : std::string(kStandardStream);
+  if (!jsonPath.empty()) outputs.push_back({jsonPath, pathsToJson(report, raster.paths.path)});
+  if (!options.gcodePath.empty()) outputs.push_back({options.gcodePath, gcodeProgram(raster.paths.path, gcodeOptions)});
+  writeOutputs(outputs, "");
+  if (jsonPath != kStandardStream) {
+    fmt::print(stderr,
+               "scallop: {}: raster paths on {} triangles, {} lines {:.6g} to {:.6g} apart, tool-centre length {:.6g} "
+               "{}, every move proven (deepest ball interference {:.3g}, exact); {}; {:.3f} s\n",
+               source, job.mesh.triangles.size(), raster.paths.lines, raster.paths.minSpacing, report.spacing,
+               raster.paths.centreLength, unitsName(units), report.gouge->maxDepth, cycleSummary(report, units),
+               report.seconds);
+  }
+}
 
 void runPaths(const PathsOptions& options) {
   requireOneSurfaceSource(options.surface, "paths");
   if (options.spacing.empty() == options.scallopHeight.empty())
     throw CLI::ValidationError("paths", "give exactly one of --spacing and --scallop-height");
-  if (options.strategy == "contour" && !options.angle.empty())
-    throw CLI::ValidationError("paths", "--angle is for --strategy raster");
   if (options.strategy == "raster" && options.normal != "auto")
     throw CLI::ValidationError("paths", "--normal is for --strategy contour");
+  if (isStlSource(options.surface.input)) {
+    if (options.tessellate || !options.deflection.empty())
+      throw Error(fmt::format("{}: --tessellate and --deflection are for STEP and IGES parts; an STL file is a mesh "
+                              "already",
+                              sourceName(options.surface)));
+    MeshJob mesh;
+    mesh.mesh = loadStlMesh(options.surface.input, options.units, options.dropZeroArea).mesh;
+    return runPathsMesh(options, mesh);
+  }
+  if (!options.units.empty() || options.dropZeroArea)
+    throw Error("--units and --drop-zero-area are for STL meshes (a .stl file); a surface's units are in its file");
+  const bool cad = !options.surface.input.empty() && options.surface.input != "-" &&
+                   cadFormatOf(options.surface.input).has_value();
+  if (!cad && (options.tessellate || !options.deflection.empty()))
+    throw Error("--tessellate and --deflection are for STEP and IGES parts (.step, .stp, .iges, .igs)");
+  if (cad && options.surface.skipFaces && options.tessellate)
+    throw Error(fmt::format("{}: --skip-faces keeps only the faces imported exactly, --tessellate all of them "
+                            "through the mesh: give one",
+                            options.surface.input));
+  if (cad && !options.surface.skipFaces) {
+    const CadPart part(options.surface.input);
+    std::optional<CadImport> exact;
+    if (!options.tessellate) exact = part.exactFaces();
+    if (options.tessellate || !exact->skipped.empty()) {
+      MeshRasterRequest request;
+      request.source = sourceName(options.surface);
+      request.command = "paths";
+      request.toolRadius = options.toolRadius;
+      request.scallopHeight = options.scallopHeight;
+      request.spacing = options.spacing;
+      request.quiet = options.jsonPath.empty() && options.gcodePath.empty();  // JSON on stdout: stderr quiet too
+      MeshJob mesh = tessellatedJob(part, exact, request, options.deflection);
+      mesh.part = &part;
+      return runPathsMesh(options, mesh);
+    }
+  }
+  if (!options.deflection.empty())
+    throw Error(fmt::format("{}: --deflection is for a tessellated part (--tessellate, or faces that cannot be "
+                            "machined exactly); this one is cut on its exact faces",
+                            sourceName(options.surface)));
+  const std::string strategy = options.strategy.empty() ? "contour" : options.strategy;
+  if (strategy == "contour" && !options.angle.empty())
+    throw CLI::ValidationError("paths", "--angle is for --strategy raster");
   JobOptions job;
-  job.strategy = options.strategy;
+  job.strategy = strategy;
   job.toolRadius = parsePositive(options.toolRadius, "tool radius", "a positive length");
   if (!options.spacing.empty())
     job.spacing = parsePositive(options.spacing, "spacing", "a positive length");
@@ -71,9 +174,6 @@ void runPaths(const PathsOptions& options) {
   job.constantSpacing = options.constantSpacing;
   job.linking.direction = options.oneWay ? PassDirection::keep : PassDirection::zigzag;
 
-  if (isStlSource(options.surface.input))
-    throw Error(fmt::format("{}: paths takes Bezier surfaces (JSON, .bpt, STEP, IGES); an STL mesh goes through "
-                            "scallop plan (raster by exact drop lines)", options.surface.input));
   const Surface surface = loadSurface(options.surface);
   const std::string source = sourceName(options.surface);
   const double rapidRate = options.rapidRate.empty()
@@ -81,7 +181,7 @@ void runPaths(const PathsOptions& options) {
                                : parsePositive(options.rapidRate, "rapid rate", "a positive rate");
   JobResult result = runToolpathJob(surface, source, job, std::nullopt, {});
   const GcodeDialect dialect = gcodeDialect(options.dialect);
-  const std::string title = fmt::format("scallop paths {} {}", options.strategy, source);
+  const std::string title = fmt::format("scallop paths {} {}", strategy, source);
   const GcodeOptions gcodeOptions = defaultGcodeOptions(surface, result.path, dialect, title);
   result.report.motion = gcodeMotion(result.path, gcodeOptions, rapidRate);
   result.report.feedRate = gcodeOptions.feedRate;
@@ -96,7 +196,7 @@ void runPaths(const PathsOptions& options) {
   if (!options.svgPath.empty()) {
     outputs.push_back({options.svgPath,
                        pathsSvg(surface, result.contactCurves, result.path,
-                                fmt::format("scallop paths: {} strategy, {}", options.strategy, source),
+                                fmt::format("scallop paths: {} strategy, {}", strategy, source),
                                 /*planView=*/false)});
   }
   writeOutputs(outputs, "");
@@ -105,7 +205,7 @@ void runPaths(const PathsOptions& options) {
     fmt::print(stderr,
                "scallop: {}: {} paths, spacing {:.6g}, {} planes, {} components, tool-centre "
                "length {:.6g} {}; {}; {:.3f} s\n",
-               source, options.strategy, result.report.spacing, s.planes, s.components,
+               source, strategy, result.report.spacing, s.planes, s.components,
                s.centreLength, unitsName(surface.units), cycleSummary(result.report, surface.units),
                result.report.seconds);
   }
@@ -127,7 +227,7 @@ void addPathsCommand(CLI::App& app) {
       "the planes and the surface: Delta = 2 sqrt(2 R H - H^2) sin(alpha).\n"
       "Example: scallop paths --example paper-1 --tool-radius 0.25 --scallop-height 0.001 "
       "--gcode out.ngc --svg out.svg");
-  addSurfaceSourceOptions(*paths, options->surface, "surface file (JSON or .bpt; .step/.stp or .iges/.igs); - reads standard input",
+  addSurfaceSourceOptions(*paths, options->surface, "surface file (JSON or .bpt; .step/.stp or .iges/.igs; .stl: a triangle mesh, cut by raster); - reads standard input",
                           "use a built-in example surface");
   paths->add_option("--tool-radius", options->toolRadius, "ball radius R, in the surface's units")
       ->required()
@@ -154,6 +254,12 @@ void addPathsCommand(CLI::App& app) {
   paths->add_option("--gcode", options->gcodePath, "write the G-code program")->type_name("OUT");
   paths->add_option("--svg", options->svgPath, "write a picture of the surface, the sections and the paths")
       ->type_name("OUT");
+  addStlOptions(*paths, options->units, options->dropZeroArea);
+  paths->add_flag("--tessellate", options->tessellate,
+                  "STEP/IGES: raster on the part's tessellation, the proofs kept 1.5 times the measured deviation "
+                  "farther (parts with trimmed or rational faces are cut so without it)");
+  paths->add_option("--deflection", options->deflection, "STEP/IGES tessellation: OCCT mesher's linear deflection (default H/8)")
+      ->type_name("D");
   paths->add_flag("--no-gouge-check", options->noGougeCheck, "skip the sampled ball-against-surface check (the drop envelope's proof stays)");
   paths->callback([options] { runPaths(*options); });
 }

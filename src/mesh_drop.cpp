@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 #include <tuple>
 
@@ -489,7 +490,10 @@ struct LineContext {
   }
 
   // Appends the move a -> b (a already out), halved until proven and within the sag check.
-  void refine(const DropLineVertex& a, const DropLineVertex& b, int depth) {
+  // `mid`, when known, is the drop at b's and a's midpoint 0.5 (a.t + b.t) (the parent's
+  // quarter point: each halving then costs two new drops, not three).
+  void refine(const DropLineVertex& a, const DropLineVertex& b, int depth,
+              const std::optional<DropLineVertex>& mid = std::nullopt) {
     const double tm = 0.5 * (a.t + b.t);
     const bool splittable = tm > a.t && tm < b.t && depth < kMeshMaxHalvings;
     if (!splittable) {
@@ -498,24 +502,32 @@ struct LineContext {
       push(b);
       return;
     }
-    // The sag check first, at the quarter points and the midpoint (the halving reuses the
-    // midpoint): drops are cheaper than a proof. Three points, not one: next to a steep
-    // stretch the envelope's largest sag above a chord sits off its middle (over an arc
+    // The sag check first, at the quarter points and the midpoint (the halving reuses all
+    // three): drops are cheaper than a proof. Three points, not one: next to a steep stretch
+    // the envelope's largest sag above a chord sits off its middle (over an arc
     // z = sqrt(2 R s) from a silhouette, at a quarter of the chord).
-    DropLineVertex m = at(tm);
+    const DropLineVertex m = mid ? *mid : at(tm);
     const auto sagAt = [&](const DropLineVertex& v, double f) {
       return v.centre.z >= a.centre.z + f * (b.centre.z - a.centre.z) - sag;
     };
-    if (sagAt(m, 0.5) && sagAt(at(a.t + 0.25 * (b.t - a.t)), 0.25) &&
-        sagAt(at(a.t + 0.75 * (b.t - a.t)), 0.75)) {
+    std::optional<DropLineVertex> q1, q3;  // at the quarter points, as the halves' midpoints
+    const auto quarter1 = [&]() -> const DropLineVertex& {
+      if (!q1) q1 = at(0.5 * (a.t + m.t));
+      return *q1;
+    };
+    const auto quarter3 = [&]() -> const DropLineVertex& {
+      if (!q3) q3 = at(0.5 * (m.t + b.t));
+      return *q3;
+    };
+    if (sagAt(m, 0.5) && sagAt(quarter1(), 0.25) && sagAt(quarter3(), 0.75)) {
       ++out->proofs;
       if (cutter->segmentClear(a.centre, b.centre, clearance)) {
         push(b);
         return;
       }
     }
-    refine(a, m, depth + 1);
-    refine(m, b, depth + 1);
+    refine(a, m, depth + 1, q1);
+    refine(m, b, depth + 1, q3);
   }
 };
 

@@ -372,6 +372,13 @@ TEST_F(CadTessellationCli, PlanCutsATrimmedRationalPartThroughItsTessellationWit
   ASSERT_EQ(verify.exitCode, 0) << verify.err;
   const auto judged = nlohmann::json::parse(scallop::test::readFile(workDir_ / "verify.json"));
   EXPECT_LE(judged["gouge"]["max"].get<double>(), 0.0025);
+  // `paths` cuts the part the same way: plan's program but for its title line.
+  const scallop::test::RunResult paths =
+      run("paths pocket.step --tool-radius 1.5 --scallop-height 0.05 --gcode paths.ngc");
+  ASSERT_EQ(paths.exitCode, 0) << paths.err;
+  const auto body = [](const std::string& program) { return program.substr(program.find('\n')); };
+  EXPECT_EQ(body(scallop::test::readFile(workDir_ / "paths.ngc")),
+            body(scallop::test::readFile(workDir_ / "out" / "toolpath.ngc")));
 }
 
 TEST_F(CadTessellationCli, PlanAndVerifyOpenCascadesSampleStepAndIgesParts) {

@@ -245,6 +245,22 @@ TEST_F(PathsCli, PlanCutsAnStlMeshByRaster) {
   EXPECT_EQ(body(readFile(workDir_ / "n" / "toolpath.ngc")), body(program));
   const RunResult verified = run("verify paper1.mesh m/toolpath.ngc --units in --radius 0.25 --fail-on-gouge");
   EXPECT_EQ(verified.exitCode, 0) << verified.err;
+  // `paths` on the mesh: the same raster as JSON and G-code (the program as plan's).
+  const RunResult paths =
+      run("paths paper1.stl --units in --tool-radius 0.25 --scallop-height 0.001 --json p.json --gcode p.ngc");
+  ASSERT_EQ(paths.exitCode, 0) << paths.err;
+  EXPECT_EQ(body(readFile(workDir_ / "p.ngc")), body(program));
+  const auto json = nlohmann::json::parse(readFile(workDir_ / "p.json"));
+  EXPECT_EQ(json["strategy"], "raster");
+  EXPECT_EQ(json["stats"]["planes"], report["stats"]["planes"]);
+  EXPECT_EQ(json["passes"].size(), report["passes"].size());
+  for (const char* option : {"--svg x.svg", "--strategy contour", "--angle 30", "--no-gouge-check"}) {
+    const RunResult refused =
+        run(std::string("paths paper1.stl --units in --tool-radius 0.25 --scallop-height 0.001 --json x.json ") + option);
+    EXPECT_EQ(refused.exitCode, 1) << option;
+    EXPECT_NE(refused.err.find("not for a mesh"), std::string::npos) << refused.err;
+    EXPECT_FALSE(fs::exists(workDir_ / "x.json"));
+  }
 }
 
 // A plate at z = 0 over a hidden pyramid reaching down to z = -20 (mm), as OpenCAMLib's
