@@ -21,6 +21,7 @@
 #include "arguments.hpp"
 #include "commands.hpp"
 #include "output_directory.hpp"
+#include "scallop/cad_tessellation.hpp"
 #include "scallop/error.hpp"
 #include "scallop/file_output.hpp"
 #include "scallop/mesh.hpp"
@@ -53,6 +54,8 @@ struct OrientOptions {
   bool latticeSeeds = false;  // --lattice-seeds
   std::string units;      // --units in|mm: an STL mesh's (STL has none)
   bool dropZeroArea = false;  // --drop-zero-area: an STL mesh's zero-area triangles
+  bool tessellate = false;    // --tessellate: a STEP/IGES part oriented by its tessellation
+  std::string deflection;     // --deflection D: that tessellation's
 };
 
 // Where the JSON goes: --json, or standard output when no output is named at all.
@@ -85,6 +88,52 @@ void runOrientMesh(const OrientOptions& options) {
                mesh.zeroAreaDropped > 0 ? fmt::format(", {} of zero area dropped", mesh.zeroAreaDropped) : std::string(),
                result.distinctNormals, result.normal.x, result.normal.y, result.normal.z, toDegrees(result.alphaRad),
                result.greatCircle ? " (every normal on one great circle: its pole)" : "", seconds, jsonPath);
+  }
+}
+
+// `orient` on a STEP or IGES part with faces the exact importer refuses (trimmed, rational),
+// or with --tessellate: the largest empty cap of the +-exact normals sampled at its
+// tessellation's nodes and inside its triangles: an upper bound of the part's alpha*, not
+// certified.
+void runOrientTessellated(const OrientOptions& options, const CadPart& part, const std::optional<CadImport>& exact) {
+  const std::string source = sourceName(options.surface);
+  const auto reject = [&](bool given, const char* option, const char* why) {
+    if (given) throw Error(fmt::format("{}: {} {}; not for a tessellated part", source, option, why));
+  };
+  reject(!options.surface.patches.empty(), "--patches", "selects Bezier patches");
+  reject(!options.tolerance.empty(), "--tolerance", "is the polygonal Gauss map's (a mesh's is exact)");
+  reject(!options.svgDir.empty(), "--svg-dir", "draws a surface's Gauss map");
+  reject(options.noCertify || options.latticeSeeds, "--no-certify/--lattice-seeds", "apply to Bezier surfaces");
+  const auto start = std::chrono::steady_clock::now();
+  const std::string jsonPath = jsonDestination(options);
+  const bool talk = jsonPath != kStandardStream;
+  if (exact && talk)
+    fmt::print(stderr,
+               "scallop: {}: {} of {} faces cannot be imported as exact Bezier patches yet (the first: {}): oriented "
+               "by its tessellation\n",
+               source, exact->skipped.size(), part.faces(), exact->skipped.front().reason);
+  TessellationOptions tessellation;
+  // The normals matter here: a finer angular deflection than the plan's, and a deflection of
+  // 1e-3 of the part's size unless given.
+  tessellation.angularDeflection = 0.1;
+  tessellation.deflection = options.deflection.empty()
+                                ? 1e-3 * norm(part.boxHigh() - part.boxLow())
+                                : parsePositive(options.deflection, "deflection", "a positive length");
+  const CadTessellation mesh = part.tessellate(tessellation);
+  if (mesh.sampledNormals.empty())
+    throw Error(fmt::format("{}: no exact normal could be sampled on its faces", source));
+  const MeshSlicing result = optimalNormalSlicing(mesh.sampledNormals);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const TessellationFacts facts{part.units(), part.faces(), tessellation.deflection, mesh.deviation,
+                                mesh.normalDeviationRad, mesh.sampledNormals.size()};
+  writeOutputs({{jsonPath, tessellationOrientationToJson(result, facts, source, seconds)}}, "");
+  if (talk) {
+    fmt::print(stderr,
+               "scallop: {}: {} exact normals sampled on its {} faces (at the nodes and inside the triangles of its "
+               "tessellation): N* = ({:.6f}, {:.6f}, {:.6f}), alpha* <= {:.4f} deg (theirs: normals between the "
+               "samples can only lower it), not certified; {:.3f} s -> {}\n",
+               source, result.normalsGiven, part.faces(), result.normal.x, result.normal.y, result.normal.z,
+               toDegrees(result.alphaRad), seconds, jsonPath);
   }
 }
 
@@ -168,6 +217,24 @@ void runOrient(const OrientOptions& options) {
   }
   if (!options.units.empty() || options.dropZeroArea)
     throw Error("--units and --drop-zero-area are for STL meshes (a .stl file); a surface's units are in its file");
+  const bool cad = !options.surface.input.empty() && options.surface.input != "-" &&
+                   cadFormatOf(options.surface.input).has_value();
+  if (!cad && (options.tessellate || !options.deflection.empty()))
+    throw Error("--tessellate and --deflection are for STEP and IGES parts (.step, .stp, .iges, .igs)");
+  if (cad && options.surface.skipFaces && options.tessellate)
+    throw Error(fmt::format("{}: --skip-faces orients the faces imported exactly, --tessellate all of them by the "
+                            "mesh: give one",
+                            options.surface.input));
+  if (cad && !options.surface.skipFaces) {
+    const CadPart part(options.surface.input);
+    std::optional<CadImport> exact;
+    if (!options.tessellate) exact = part.exactFaces();
+    if (options.tessellate || !exact->skipped.empty()) return runOrientTessellated(options, part, exact);
+  }
+  if (!options.deflection.empty())
+    throw Error(fmt::format("{}: --deflection is for a tessellated part (--tessellate, or faces that cannot be "
+                            "imported exactly); this one is oriented on its exact faces",
+                            sourceName(options.surface)));
   OptimalSlicingOptions slicingOptions;  // the library's default tolerance unless given
   double toleranceDeg = defaultToleranceDeg();
   if (!options.tolerance.empty()) {
@@ -256,6 +323,12 @@ void addOrientCommand(CLI::App& app) {
                    "also polish from the best directions of a fixed lattice of 2,000 (a "
                    "safety net beside the medial axis; off: the paper's method alone)");
   addStlOptions(*orient, options->units, options->dropZeroArea);
+  orient->add_flag("--tessellate", options->tessellate,
+                   "STEP/IGES: orient the part by its tessellation's facets (not certified) even when every face "
+                   "could be imported exactly; parts with trimmed or rational faces are oriented so without it");
+  orient->add_option("--deflection", options->deflection,
+                     "STEP/IGES tessellation: OCCT mesher's linear deflection (default 1e-3 of the part's size)")
+      ->type_name("D");
   orient->callback([options] { runOrient(*options); });
 }
 

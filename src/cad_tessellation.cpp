@@ -215,6 +215,17 @@ CadTessellation CadPart::tessellate(const TessellationOptions& options) const {
     const bool hasUV = triangulation->HasUVNodes();
     std::optional<BRepAdaptor_Surface> exact;
     if (hasUV) exact.emplace(face);  // the face's location applied: points in the mesh's frame
+    if (exact) {
+      for (int n = 1; n <= triangulation->NbNodes(); ++n) {
+        gp_Pnt onFace;
+        gp_Vec du, dv;
+        exact->D1(triangulation->UVNode(n).X(), triangulation->UVNode(n).Y(), onFace, du, dv);
+        const gp_Vec cross = du.Crossed(dv);
+        const Vec3 normal{cross.X(), cross.Y(), cross.Z()};
+        const double length = norm(normal);
+        if (length > 0.0 && std::isfinite(length)) result.sampledNormals.push_back(normal / length);
+      }
+    }
     for (int t = 1; t <= triangulation->NbTriangles(); ++t) {
       int n1 = 0, n2 = 0, n3 = 0;
       triangulation->Triangle(t).Get(n1, n2, n3);
@@ -232,6 +243,7 @@ CadTessellation CadPart::tessellate(const TessellationOptions& options) const {
       if (!exact) continue;
       const std::array<gp_Pnt2d, 3> uv{triangulation->UVNode(n1), triangulation->UVNode(n2),
                                        triangulation->UVNode(n3)};
+      const Vec3 facetNormal = cross(b - a, c - a) / norm(cross(b - a, c - a));
       for (int i = 0; i <= kLatticeSteps; ++i) {
         for (int j = 0; i + j <= kLatticeSteps; ++j) {
           const int k = kLatticeSteps - i - j;
@@ -239,8 +251,19 @@ CadTessellation CadPart::tessellate(const TessellationOptions& options) const {
           const double wa = i / double(kLatticeSteps), wb = j / double(kLatticeSteps), wc = k / double(kLatticeSteps);
           const double u = wa * uv[0].X() + wb * uv[1].X() + wc * uv[2].X();
           const double v = wa * uv[0].Y() + wb * uv[1].Y() + wc * uv[2].Y();
-          const Vec3 p = toVec(exact->Value(u, v));
+          gp_Pnt onFace;
+          gp_Vec du, dv;
+          exact->D1(u, v, onFace, du, dv);
+          const Vec3 p = toVec(onFace);
           ++result.deviationSamples;
+          const gp_Vec cross = du.Crossed(dv);
+          const Vec3 exactNormal{cross.X(), cross.Y(), cross.Z()};
+          const double exactLength = norm(exactNormal);
+          if (exactLength > 0.0 && std::isfinite(exactLength)) {
+            const double cosine = std::min(1.0, std::abs(dot(exactNormal, facetNormal)) / exactLength);
+            result.normalDeviationRad = std::max(result.normalDeviationRad, std::acos(cosine));
+            if (i > 0 && j > 0 && k > 0) result.sampledNormals.push_back(exactNormal / exactLength);
+          }
           const double d = pointTriangleDistance(p, a, b, c);
           if (d > result.deviation) {
             result.deviation = d;

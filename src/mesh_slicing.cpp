@@ -113,16 +113,28 @@ double meshSlicingAngle(const Mesh& mesh, const Vec3& unitNormal) {
 }
 
 MeshSlicing optimalMeshSlicing(const Mesh& mesh) {
-  MeshSlicing out;
   std::vector<Vec3> normals;
   normals.reserve(mesh.triangles.size());
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
     const Vec3 n = triangleNormal(mesh, t);
     if (n == Vec3{0.0, 0.0, 0.0}) continue;
-    ++out.triangles;
-    normals.push_back(canonical(n));
+    normals.push_back(n);
   }
   if (normals.empty()) throw Error("optimal slicing of a mesh: no triangle of positive area");
+  MeshSlicing out = optimalNormalSlicing(std::move(normals));
+  out.triangles = out.normalsGiven;
+  return out;
+}
+
+MeshSlicing optimalNormalSlicing(std::vector<Vec3> normals) {
+  MeshSlicing out;
+  if (normals.empty()) throw Error("optimal slicing of a set of normals: the set is empty");
+  for (Vec3& n : normals) {
+    if (!(std::abs(norm(n) - 1.0) <= 1e-9))
+      throw Error(fmt::format("optimal slicing of a set of normals: ({}, {}, {}) is not a unit vector", n.x, n.y, n.z));
+    n = canonical(n);
+  }
+  out.normalsGiven = normals.size();
   std::sort(normals.begin(), normals.end(), [](const Vec3& a, const Vec3& b) {
     return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z;
   });

@@ -1105,4 +1105,26 @@ std::string meshOrientationToJson(const MeshSlicing& result, const StlMesh& mesh
   return json::format(document);
 }
 
+std::string tessellationOrientationToJson(const MeshSlicing& result, const TessellationFacts& facts,
+                                          const std::string& source, double seconds) {
+  nlohmann::ordered_json document;
+  document["input"] = "tessellation";
+  document["source"] = source;
+  document["units"] = std::string(unitsName(facts.units));
+  document["faces"] = facts.faces;
+  document["deflection"] = facts.deflection;
+  document["deviation"] = facts.deviation;
+  document["facet_normal_angle_deg"] = toDegrees(facts.normalAngleRad);
+  document["normals_sampled"] = facts.normalsSampled;
+  document["distinct_normals"] = result.distinctNormals;
+  document["hull_facets"] = result.hullFacets;
+  document["great_circle"] = result.greatCircle;
+  document["normal"] = {result.normal.x, result.normal.y, result.normal.z};
+  document["alpha_deg"] = toDegrees(result.alphaRad);
+  document["alpha_is"] = "upper bound";
+  document["certified"] = false;
+  document["seconds"] = seconds;
+  return json::format(document);
+}
+
 }  // namespace scallop

@@ -38,6 +38,7 @@
 #include "scallop/cut_simulation.hpp"
 #include "scallop/error.hpp"
 #include "scallop/gcode_reader.hpp"
+#include "scallop/mesh_slicing.hpp"
 #include "scallop/surface_io.hpp"
 
 namespace {
@@ -247,6 +248,84 @@ TEST_F(CadTessellationTest, BadOptionsAreRefusedByName) {
   expectErrorMentions([&] { (void)part.tessellate(options); }, {"pocket.step", "budget"});
 }
 
+// --- sampled exact normals and the orientation over them --------------------------------------
+
+TEST_F(CadTessellationTest, ThePocketBlocksSampledNormalsGiveItsClosedFormOrientation) {
+  // Its normals: +-z (top, floor, bottom), +-x and +-y (sides) and every horizontal direction
+  // (the pocket's wall). The farthest direction from all of them stands 45 deg above the
+  // horizon: alpha* = 45 deg exactly. Sampled, the wall's directions have gaps, through which
+  // the samples' optimum may rise a little above it (an upper bound, as documented).
+  const fs::path path = dir_ / "pocket.step";
+  writeStep(pocketBlock(), path, "MM");
+  const CadPart part(path.string());
+  scallop::TessellationOptions options;
+  options.deflection = 0.01;
+  options.angularDeflection = 0.1;
+  const CadTessellation mesh = part.tessellate(options);
+  for (const Vec3& n : mesh.sampledNormals) ASSERT_NEAR(norm(n), 1.0, 1e-12);
+  const scallop::MeshSlicing slicing = scallop::optimalNormalSlicing(mesh.sampledNormals);
+  const double alphaDeg = slicing.alphaRad * 180.0 / M_PI;
+  EXPECT_GE(alphaDeg, 45.0 - 1e-9);
+  EXPECT_LE(alphaDeg, 45.05);
+  EXPECT_NEAR(slicing.normal.z, std::sqrt(0.5), 1e-3);
+  EXPECT_EQ(slicing.normalsGiven, mesh.sampledNormals.size());
+  expectErrorMentions([] { (void)scallop::optimalNormalSlicing({}); }, {"empty"});
+  expectErrorMentions([] { (void)scallop::optimalNormalSlicing({Vec3{1.0, 1.0, 0.0}}); }, {"not a unit vector"});
+}
+
+// The same on a trimmed free-form face (paper-1's patch over a disk), against a brute force
+// written here: alpha(N) = the least angle between N and the +-normals of a dense polar sample
+// of the Bezier surface over the disk (scallop's derivatives, not OCCT's), maximised over a
+// fine grid of directions N around the samples' optimum and polished by coordinate search.
+TEST_F(CadTessellationTest, TheTrimmedFaceOrientationAgreesWithABruteForceOverItsNormals) {
+  const Surface paper = exampleFile("paper-1");
+  const fs::path path = dir_ / "disk.step";
+  writeStep(paperDiskFace(paper), path, "INCH");
+  const CadPart part(path.string());
+  scallop::TessellationOptions options;
+  options.deflection = 0.002;
+  options.angularDeflection = 0.1;
+  const scallop::MeshSlicing slicing = scallop::optimalNormalSlicing(part.tessellate(options).sampledNormals);
+  std::vector<Vec3> normals;
+  for (int i = 0; i <= 60; ++i)
+    for (int k = 0; k < 120; ++k) {
+      const double r = 0.9 * std::sqrt(i / 60.0) * (1.0 - 1e-9), t = 2.0 * M_PI * k / 120.0;
+      const double x = 1.5 + r * std::cos(t), y = 1.5 + r * std::sin(t);
+      normals.push_back(scallop::unitNormal(paper.patches[0], y / 3.0, x / 3.0));
+    }
+  const auto alphaOf = [&](Vec3 n) {
+    n = n / norm(n);
+    double least = M_PI / 2.0;
+    for (const Vec3& m : normals) least = std::min(least, std::atan2(norm(cross(n, m)), std::abs(dot(n, m))));
+    return least;
+  };
+  // Start from the samples' N* and climb on a shrinking grid: the brute force's own optimum.
+  Vec3 best = slicing.normal;
+  double bestAlpha = alphaOf(best);
+  for (double step = 0.05; step > 1e-5; step *= 0.5) {
+    bool moved = true;
+    while (moved) {
+      moved = false;
+      for (const Vec3 d : {Vec3{step, 0, 0}, Vec3{-step, 0, 0}, Vec3{0, step, 0}, Vec3{0, -step, 0}, Vec3{0, 0, step},
+                           Vec3{0, 0, -step}}) {
+        const double a = alphaOf(best + d);
+        if (a > bestAlpha) {
+          bestAlpha = a;
+          best = (best + d) / norm(best + d);
+          moved = true;
+        }
+      }
+    }
+  }
+  const double sampledDeg = slicing.alphaRad * 180.0 / M_PI, bruteDeg = bestAlpha * 180.0 / M_PI;
+  std::printf("[          ] trimmed disk: alpha* over OCCT-sampled normals %.4f deg, brute force %.4f deg\n",
+              sampledDeg, bruteDeg);
+  EXPECT_NEAR(sampledDeg, bruteDeg, 0.25);
+  // The disk's normals are a subset of the whole patch's: its alpha* is at least the patch's
+  // certified one (78.0376 deg is the certificate's bound; 78.048 deg the optimum).
+  EXPECT_GE(sampledDeg, 78.03);
+}
+
 // --- exact heights ----------------------------------------------------------------------------
 
 TEST_F(CadTessellationTest, ExactHeightsOfThePocketBlockAreItsClosedForm) {
@@ -410,6 +489,23 @@ TEST_F(CadTessellationCli, PlanAndVerifyOpenCascadesSampleStepAndIgesParts) {
     EXPECT_EQ(verify.exitCode, 0) << sample.file << ": " << verify.err;
     fs::remove_all(workDir_ / "out");
   }
+}
+
+TEST_F(CadTessellationCli, OrientTakesAPartWithTrimmedAndRationalFacesBySampledNormals) {
+  writeStep(pocketBlock(), workDir_ / "pocket.step", "MM");
+  const scallop::test::RunResult orient = run("orient pocket.step --json o.json");
+  ASSERT_EQ(orient.exitCode, 0) << orient.err;
+  EXPECT_NE(orient.err.find("alpha* <= "), std::string::npos) << orient.err;
+  EXPECT_NE(orient.err.find("not certified"), std::string::npos) << orient.err;
+  const auto json = nlohmann::json::parse(scallop::test::readFile(workDir_ / "o.json"));
+  EXPECT_EQ(json["input"], "tessellation");
+  EXPECT_EQ(json["alpha_is"], "upper bound");
+  EXPECT_EQ(json["certified"], false);
+  EXPECT_GE(json["alpha_deg"].get<double>(), 45.0 - 1e-9);
+  EXPECT_LE(json["alpha_deg"].get<double>(), 45.05);
+  fs::remove(workDir_ / "o.json");
+  expectCleanFailure(run("orient pocket.step --svg-dir figs"), {"pocket.step", "--svg-dir", "tessellated"},
+                     "pocket.step");
 }
 
 TEST_F(CadTessellationCli, TessellationOptionsAreRefusedWhereTheyDoNotApply) {

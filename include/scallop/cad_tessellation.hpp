@@ -40,7 +40,10 @@
 //         distance may be larger (for a smooth face, whose distance to a small triangle is
 //         close to a quadratic that vanishes at its corners, by a few per cent). Callers
 //         that need a bound add a margin; `scallop plan` uses 1.5 times it and the judge
-//         below checks the result.
+//         below checks the result. At the same points the angle between the exact face's
+//         normal (BRepAdaptor_Surface::D1; a point where it vanishes is skipped) and the
+//         triangle's, as lines, gives normalDeviationRad: how far `scallop orient`'s facet
+//         normals may stand from the part's.
 // Heights (designHeights): for each point (x, y) of the grid inside the part's xy bounding
 //         box, the vertical line through it is intersected with every face
 //         (IntCurvesFace_ShapeIntersector: exact surfaces, points classified against the
@@ -84,6 +87,13 @@ struct CadTessellation {
   Vec3 deviationAt;                           ///< the exact face's point where it occurs
   std::size_t deviationFace = 0;              ///< and its face
   std::size_t deviationSamples = 0;           ///< points evaluated
+  /// The largest angle between the exact face's unit normal and its triangle's, over the same
+  /// samples (as lines: the sense ignored; radians).
+  double normalDeviationRad = 0.0;
+  /// The exact faces' unit normals (as D1 gives them, the face's orientation ignored) at
+  /// every node of every face's triangulation and at the 3 interior points of each
+  /// triangle's lattice: `scallop orient`'s sample of the part's Gauss map.
+  std::vector<Vec3> sampledNormals;
   std::size_t degenerateTriangles = 0;        ///< dropped (no area)
   double seconds = 0.0;
 };

@@ -46,10 +46,16 @@ struct MeshSlicing {
   std::size_t distinctNormals = 0;  ///< distinct unit normals up to sign
   std::size_t hullFacets = 0;       ///< 0 when degenerate
   bool greatCircle = false;         ///< every +-normal on one great circle (see the contract)
+  std::size_t normalsGiven = 0;     ///< the normals the optimum was taken over
 };
 
 /// See the contract.
 MeshSlicing optimalMeshSlicing(const Mesh& mesh);
+
+/// The same over a set of unit normals instead of a mesh's facets (a part's exact normals
+/// sampled: cad_tessellation.hpp): the largest empty cap of their +-set. `triangles` is 0.
+/// scallop::Error for an empty set or a normal that is not a unit vector (to 1e-9).
+MeshSlicing optimalNormalSlicing(std::vector<Vec3> unitNormals);
 
 /// alpha(N) of the contract for a unit N: the least angle between N and +-n_t, radians.
 double meshSlicingAngle(const Mesh& mesh, const Vec3& unitNormal);

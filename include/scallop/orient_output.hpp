@@ -68,6 +68,23 @@ std::string orientationToJson(const OptimalSlicing& result, double toleranceDeg)
 std::string meshOrientationToJson(const MeshSlicing& result, const StlMesh& mesh, const std::string& source,
                                   double seconds);
 
+/// What `scallop orient` says of a STEP or IGES part oriented by its tessellation
+/// (cad_tessellation.hpp): the facts of the mesh beside the facets' optimum.
+struct TessellationFacts {
+  Units units = Units::millimetre;
+  std::size_t faces = 0;
+  double deflection = 0.0;        ///< asked of OCCT's mesher
+  double deviation = 0.0;         ///< sampled distance, exact faces to their triangles
+  double normalAngleRad = 0.0;    ///< sampled angle, exact normals to their facets'
+  std::size_t normalsSampled = 0;
+};
+
+/// meshOrientationToJson for a tessellated part: input "tessellation", the facts, and the
+/// optimum over the part's sampled exact normals (optimalNormalSlicing): alpha_deg is then an
+/// upper bound of the part's alpha* ("alpha_is": "upper bound"), not certified.
+std::string tessellationOrientationToJson(const MeshSlicing& result, const TessellationFacts& facts,
+                                          const std::string& source, double seconds);
+
 /// The symmetrized Gauss map and the optimal circle on the unit sphere (see above).
 std::string gaussMapSphereSvg(const OptimalSlicing& result);
 
