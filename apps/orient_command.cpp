@@ -228,7 +228,7 @@ void runOrient(const OrientOptions& options) {
   if (cad && !options.surface.skipFaces) {
     const CadPart part(options.surface.input);
     std::optional<CadImport> exact;
-    if (!options.tessellate) exact = part.exactFaces();
+    if (!options.tessellate) exact = part.exactFaces(/*acceptRational=*/true);
     if (options.tessellate || !exact->skipped.empty()) return runOrientTessellated(options, part, exact);
   }
   if (!options.deflection.empty())
@@ -244,7 +244,9 @@ void runOrient(const OrientOptions& options) {
   slicingOptions.certify = !options.noCertify;
   slicingOptions.latticeSeeds = options.latticeSeeds;
 
-  const Surface surface = loadSurface(options.surface);
+  SurfaceSource source = options.surface;
+  source.acceptRational = true;  // the Gauss map takes rational patches (bezier.hpp)
+  const Surface surface = loadSurface(source);
   const OptimalSlicing result = optimalSlicing(surface, slicingOptions);
 
   std::vector<OutputFile> outputs;

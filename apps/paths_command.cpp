@@ -176,6 +176,11 @@ void runPaths(const PathsOptions& options) {
 
   const Surface surface = loadSurface(options.surface);
   const std::string source = sourceName(options.surface);
+  try {
+    requirePolynomial(surface, "scallop paths");
+  } catch (const Error& error) {
+    throw Error(fmt::format("{}: {}", source, error.what()));
+  }
   const double rapidRate = options.rapidRate.empty()
                                ? defaultRapidRate(surface.units)
                                : parsePositive(options.rapidRate, "rapid rate", "a positive rate");

@@ -267,6 +267,11 @@ void runPlan(const PlanOptions& options) {
   if (from.input.empty() && from.example.empty()) from.example = "paper-1";  // the main job
   const Surface surface = loadSurface(from, !options.quiet);
   const std::string source = sourceName(from);
+  try {
+    requirePolynomial(surface, "scallop plan");
+  } catch (const Error& error) {
+    throw Error(fmt::format("{}: {}", source, error.what()));
+  }
   const bool inch = surface.units == Units::inch;
   auto progress = [&](const std::string& line) {
     if (!options.quiet) fmt::print(stderr, "scallop plan: {}...\n", line);

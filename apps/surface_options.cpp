@@ -51,6 +51,7 @@ std::string sourceBaseName(const SurfaceSource& source) {
 Surface importCadSurface(const SurfaceSource& source, CadFormat format, bool announce) {
   CadImportOptions options;
   options.skipUnsupportedFaces = source.skipFaces;
+  options.acceptRational = source.acceptRational;
   CadImport imported = importCad(source.input, format, options);
   if (announce) {
     std::string skipped;

@@ -23,6 +23,7 @@ struct SurfaceSource {
   std::string example;
   std::string patches;
   bool skipFaces = false;
+  bool acceptRational = false;  // STEP/IGES rational faces as rational patches (orient)
 };
 
 /// Adds the SURFACE positional and --example NAME (checked against the built-in names,

@@ -97,6 +97,13 @@ int runVerify(const VerifyOptions& options) {
   } else {
     surface = loadSurface(source);
   }
+  if (surface) {
+    try {
+      requirePolynomial(*surface, "scallop verify");
+    } catch (const Error& error) {
+      throw Error(fmt::format("{}: {}", sourceName(source), error.what()));
+    }
+  }
   const Units designUnits = mesh ? stl->mesh.units : part ? part->units() : surface->units;
   const bool inch = designUnits == Units::inch;
   simulation.scallopHeight = options.scallopHeight.empty()

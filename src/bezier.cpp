@@ -30,6 +30,15 @@ void requireValid(const BezierPatch& patch, const char* what) {
     throw Error(fmt::format("{}: bidegree ({}, {}) needs {} control points, got {}", what,
                             patch.degreeU, patch.degreeV, expected, patch.control.size()));
   }
+  if (patch.rational()) {
+    if (patch.weights.size() != expected)
+      throw Error(fmt::format("{}: bidegree ({}, {}) needs {} weights, got {}", what, patch.degreeU,
+                              patch.degreeV, expected, patch.weights.size()));
+    for (std::size_t i = 0; i < expected; ++i)
+      if (!(patch.weights[i] > 0.0) || !std::isfinite(patch.weights[i]))
+        throw Error(fmt::format("{}: weight {} is {}; a rational patch's weights must be positive and finite", what,
+                                i, patch.weights[i]));
+  }
 }
 
 // In-place de Casteljau on b[0 .. n]; returns the point at t.
@@ -111,6 +120,53 @@ Vec3 partial(const BezierPatch& patch, double u, double v, int du, int dv) {
   return partialImpl<>(patch, u, v, du, dv);
 }
 
+// A rational patch's homogeneous nets as two polynomial patches: X = w p, and w in the x
+// coordinate (y = z = 0), so that partial() differences and evaluates them as any patch.
+std::pair<BezierPatch, BezierPatch> homogeneousNets(const BezierPatch& patch) {
+  BezierPatch x{patch.degreeU, patch.degreeV, patch.control, {}};
+  BezierPatch w{patch.degreeU, patch.degreeV, std::vector<Vec3>(patch.control.size()), {}};
+  for (std::size_t i = 0; i < patch.control.size(); ++i) {
+    x.control[i] = patch.weights[i] * patch.control[i];
+    w.control[i] = {patch.weights[i], 0.0, 0.0};
+  }
+  return {std::move(x), std::move(w)};
+}
+
+// r and its partials to second order of a rational patch by the quotient rule (see the
+// contract).
+PatchDerivatives rationalDerivatives(const BezierPatch& patch, double u, double v, Vec3* value) {
+  const auto [xNet, wNet] = homogeneousNets(patch);
+  const auto at = [&](const BezierPatch& net, int du, int dv) { return partial(net, u, v, du, dv); };
+  const double w = at(wNet, 0, 0).x, wu = at(wNet, 1, 0).x, wv = at(wNet, 0, 1).x;
+  const double wuu = at(wNet, 2, 0).x, wuv = at(wNet, 1, 1).x, wvv = at(wNet, 0, 2).x;
+  const Vec3 r = at(xNet, 0, 0) / w;
+  PatchDerivatives d{};
+  d.u = (at(xNet, 1, 0) - wu * r) / w;
+  d.v = (at(xNet, 0, 1) - wv * r) / w;
+  d.uu = (at(xNet, 2, 0) - 2.0 * wu * d.u - wuu * r) / w;
+  d.uv = (at(xNet, 1, 1) - wu * d.v - wv * d.u - wuv * r) / w;
+  d.vv = (at(xNet, 0, 2) - 2.0 * wv * d.v - wvv * r) / w;
+  if (value) *value = r;
+  return d;
+}
+
+// partial() of any patch: the polynomial's own, or the rational's by the quotient rule.
+Vec3 anyPartial(const BezierPatch& patch, double u, double v, int du, int dv) {
+  if (!patch.rational()) return partial(patch, u, v, du, dv);
+  Vec3 value;
+  const PatchDerivatives d = rationalDerivatives(patch, u, v, &value);
+  switch (du * 3 + dv) {
+    case 0: return value;
+    case 1: return d.v;
+    case 3: return d.u;
+    case 2: return d.vv;
+    case 4: return d.uv;
+    case 6: return d.uu;
+    default: break;
+  }
+  throw Error(fmt::format("a rational patch's partial derivative of order ({}, {}): only up to the second", du, dv));
+}
+
 // B_j^d(t), dB_j^d/dt and d2B_j^d/dt2 for j = 0..d: the basis of degree d - 2 by the
 // triangle b^e_j = (1 - t) b^(e-1)_j + t b^(e-1)_(j-1), raised to d - 1 and d, with
 //   d/dt B_j^d = d (B_(j-1)^(d-1) - B_j^(d-1)),
@@ -154,6 +210,16 @@ BezierPatch fromCoordinates(const std::array<Bernstein2, 3>& xyz) {
 
 template <class F>
 BezierPatch mapCoordinates(const BezierPatch& patch, F f) {
+  if (patch.rational()) {
+    // On the homogeneous net (X, w): the weights stay positive under subdivision (convex
+    // combinations), and the points are X / w.
+    const std::array<Bernstein2, 4> h = homogeneousPolynomials(patch);
+    const Bernstein2 w = f(h[3]);
+    BezierPatch out = fromCoordinates({f(h[0]), f(h[1]), f(h[2])});
+    out.weights = w.coefficients;
+    for (std::size_t i = 0; i < out.control.size(); ++i) out.control[i] = out.control[i] / out.weights[i];
+    return out;
+  }
   const std::array<Bernstein2, 3> xyz = coordinatePolynomials(patch);
   return fromCoordinates({f(xyz[0]), f(xyz[1]), f(xyz[2])});
 }
@@ -174,17 +240,17 @@ std::array<Bernstein2, 3> derivativesV(const std::array<Bernstein2, 3>& r) {
 
 Vec3 point(const BezierPatch& patch, double u, double v) {
   requireValid(patch, "point");
-  return partial(patch, u, v, 0, 0);
+  return anyPartial(patch, u, v, 0, 0);
 }
 
 Vec3 derivativeU(const BezierPatch& patch, double u, double v) {
   requireValid(patch, "derivativeU");
-  return partial(patch, u, v, 1, 0);
+  return anyPartial(patch, u, v, 1, 0);
 }
 
 Vec3 derivativeV(const BezierPatch& patch, double u, double v) {
   requireValid(patch, "derivativeV");
-  return partial(patch, u, v, 0, 1);
+  return anyPartial(patch, u, v, 0, 1);
 }
 
 Vec3 secondDerivative(const BezierPatch& patch, double u, double v, int du, int dv) {
@@ -194,12 +260,12 @@ Vec3 secondDerivative(const BezierPatch& patch, double u, double v, int du, int 
         "secondDerivative: orders (du, dv) must be (2, 0), (1, 1) or (0, 2), got ({}, {})", du,
         dv));
   }
-  return partial(patch, u, v, du, dv);
+  return anyPartial(patch, u, v, du, dv);
 }
 
 Vec3 normalVector(const BezierPatch& patch, double u, double v) {
   requireValid(patch, "normalVector");
-  return cross(partial(patch, u, v, 1, 0), partial(patch, u, v, 0, 1));
+  return cross(anyPartial(patch, u, v, 1, 0), anyPartial(patch, u, v, 0, 1));
 }
 
 double normalRoundingThreshold(const BezierPatch& patch) {
@@ -212,6 +278,31 @@ double normalRoundingThreshold(const BezierPatch& patch) {
   // likewise r_v, and the cross product adds 3u |r_u||r_v|: below (6(m + n) + 8) u S_u S_v
   // the computed normal may be rounding noise, and its direction meaningless.
   auto squaredNorm = [](const Vec3& d) { return dot(d, d); };
+  if (patch.rational()) {
+    // |r_u| <= (|X_u| + |w_u| |r|) / w <= (m max|dX| + m max|dw| max|p|) / min w (the
+    // quotient rule; r in the control points' convex hull), likewise r_v; the divisions and
+    // the quotient rule's products add a few roundings more than the polynomial case's.
+    double dxu = 0.0, dxv = 0.0, dwu = 0.0, dwv = 0.0, largest = 0.0, least = patch.weights[0];
+    for (int j = 0; j <= m; ++j) {
+      for (int k = 0; k <= n; ++k) {
+        const double w = patch.weight(j, k);
+        const Vec3 x = w * patch.at(j, k);
+        largest = std::max(largest, norm(patch.at(j, k)));
+        least = std::min(least, w);
+        if (j < m) {
+          dxu = std::max(dxu, norm(patch.weight(j + 1, k) * patch.at(j + 1, k) - x));
+          dwu = std::max(dwu, std::abs(patch.weight(j + 1, k) - w));
+        }
+        if (k < n) {
+          dxv = std::max(dxv, norm(patch.weight(j, k + 1) * patch.at(j, k + 1) - x));
+          dwv = std::max(dwv, std::abs(patch.weight(j, k + 1) - w));
+        }
+      }
+    }
+    const double su = m * (dxu + dwu * largest) / least;
+    const double sv = n * (dxv + dwv * largest) / least;
+    return (6.0 * (m + n) + 16.0) * kUnitRoundoff * su * sv;
+  }
   double su2 = 0.0;  // the squares (one square root each below: sqrt is monotone)
   double sv2 = 0.0;
   for (int j = 0; j <= m; ++j) {
@@ -233,7 +324,7 @@ constexpr double kCornerRayRadius = 1e-6;
 
 Vec3 unitNormal(const BezierPatch& patch, double u, double v) {
   requireValid(patch, "unitNormal");
-  const Vec3 normal = cross(partial(patch, u, v, 1, 0), partial(patch, u, v, 0, 1));
+  const Vec3 normal = cross(anyPartial(patch, u, v, 1, 0), anyPartial(patch, u, v, 0, 1));
   const double length = norm(normal);
   const double threshold = normalRoundingThreshold(patch);
   if (length > threshold) return normal / length;
@@ -286,8 +377,29 @@ BezierPatch restrictTo(const BezierPatch& patch, double u0, double u1, double v0
   return mapCoordinates(patch, [&](const Bernstein2& c) { return restrictTo(c, u0, u1, v0, v1); });
 }
 
+std::array<Bernstein2, 4> homogeneousPolynomials(const BezierPatch& patch) {
+  requireValid(patch, "homogeneousPolynomials");
+  std::array<Bernstein2, 4> xyzw;
+  for (Bernstein2& c : xyzw) {
+    c.degreeU = patch.degreeU;
+    c.degreeV = patch.degreeV;
+    c.coefficients.resize(patch.control.size());
+  }
+  for (std::size_t i = 0; i < patch.control.size(); ++i) {
+    const double w = patch.rational() ? patch.weights[i] : 1.0;
+    xyzw[0].coefficients[i] = w * patch.control[i].x;
+    xyzw[1].coefficients[i] = w * patch.control[i].y;
+    xyzw[2].coefficients[i] = w * patch.control[i].z;
+    xyzw[3].coefficients[i] = w;
+  }
+  return xyzw;
+}
+
 std::array<Bernstein2, 3> coordinatePolynomials(const BezierPatch& patch) {
   requireValid(patch, "coordinatePolynomials");
+  if (patch.rational())
+    throw Error("coordinatePolynomials: the patch is rational (its coordinates are quotients); this computation "
+                "takes polynomial patches only");
   std::array<Bernstein2, 3> xyz;
   for (Bernstein2& c : xyz) {
     c.degreeU = patch.degreeU;
@@ -302,7 +414,44 @@ std::array<Bernstein2, 3> coordinatePolynomials(const BezierPatch& patch) {
   return xyz;
 }
 
+namespace {
+
+std::array<Bernstein2, 3> crossPolynomials(const std::array<Bernstein2, 3>& a, const std::array<Bernstein2, 3>& b) {
+  return {subtract(multiply(a[1], b[2]), multiply(a[2], b[1])), subtract(multiply(a[2], b[0]), multiply(a[0], b[2])),
+          subtract(multiply(a[0], b[1]), multiply(a[1], b[0]))};
+}
+
+std::array<Bernstein2, 3> scaled(const Bernstein2& s, const std::array<Bernstein2, 3>& a) {
+  return {multiply(s, a[0]), multiply(s, a[1]), multiply(s, a[2])};
+}
+
+std::array<Bernstein2, 3> minus(const std::array<Bernstein2, 3>& a, const std::array<Bernstein2, 3>& b) {
+  return {subtract(a[0], b[0]), subtract(a[1], b[1]), subtract(a[2], b[2])};
+}
+
+// The homogeneous X (x, y, z) and w of a rational patch.
+struct Homogeneous {
+  std::array<Bernstein2, 3> x;
+  Bernstein2 w;
+};
+
+Homogeneous homogeneousOf(const BezierPatch& patch) {
+  const std::array<Bernstein2, 4> h = homogeneousPolynomials(patch);
+  return {{h[0], h[1], h[2]}, h[3]};
+}
+
+// N = w X_u x X_v - w_v X_u x X - w_u X x X_v (the contract's Rational patches).
+std::array<Bernstein2, 3> rationalNormalPolynomials(const Homogeneous& h) {
+  const std::array<Bernstein2, 3> xu = derivativesU(h.x), xv = derivativesV(h.x);
+  const Bernstein2 wu = derivativeU(h.w), wv = derivativeV(h.w);
+  return minus(minus(scaled(h.w, crossPolynomials(xu, xv)), scaled(wv, crossPolynomials(xu, h.x))),
+               scaled(wu, crossPolynomials(h.x, xv)));
+}
+
+}  // namespace
+
 std::array<Bernstein2, 3> normalPolynomials(const BezierPatch& patch) {
+  if (patch.rational()) return rationalNormalPolynomials(homogeneousOf(patch));
   const std::array<Bernstein2, 3> r = coordinatePolynomials(patch);
   const std::array<Bernstein2, 3> ru = derivativesU(r);  // (m - 1, n)
   const std::array<Bernstein2, 3> rv = derivativesV(r);  // (m, n - 1)
@@ -316,17 +465,34 @@ namespace {
 // (r_uu . N)(r_vv . N) - (r_uv . N)^2 and a bound on its terms' size,
 // |r_uu . N| |r_vv . N| + |r_uv . N|^2 (their coefficients' largest magnitudes).
 std::pair<Bernstein2, double> curvatureNumeratorAndBound(const BezierPatch& patch) {
+  auto largest = [](const Bernstein2& p) {
+    double out = 0.0;
+    for (double c : p.coefficients) out = std::max(out, std::abs(c));
+    return out;
+  };
+  if (patch.rational()) {
+    // A B - C^2 with A = w X_uu . N - w_uu X . N, and so on (the contract).
+    const Homogeneous h = homogeneousOf(patch);
+    const std::array<Bernstein2, 3> normal = rationalNormalPolynomials(h);
+    const Bernstein2 xn = dot(h.x, normal);
+    const std::array<Bernstein2, 3> xu = derivativesU(h.x);
+    const Bernstein2 wu = derivativeU(h.w);
+    const Bernstein2 mixed =
+        subtract(multiply(h.w, dot(derivativesV(xu), normal)), multiply(derivativeV(wu), xn));
+    const Bernstein2 mixedSquared = multiply(mixed, mixed);
+    if (patch.degreeU < 2 || patch.degreeV < 2) return {scale(mixedSquared, -1.0), largest(mixed) * largest(mixed)};
+    const Bernstein2 uu = subtract(multiply(h.w, dot(derivativesU(xu), normal)), multiply(derivativeU(wu), xn));
+    const std::array<Bernstein2, 3> xv = derivativesV(h.x);
+    const Bernstein2 wv = derivativeV(h.w);
+    const Bernstein2 vv = subtract(multiply(h.w, dot(derivativesV(xv), normal)), multiply(derivativeV(wv), xn));
+    return {subtract(multiply(uu, vv), mixedSquared), largest(uu) * largest(vv) + largest(mixed) * largest(mixed)};
+  }
   const std::array<Bernstein2, 3> r = coordinatePolynomials(patch);
   const std::array<Bernstein2, 3> normal = normalPolynomials(patch);  // (2m - 1, 2n - 1)
   const std::array<Bernstein2, 3> ru = derivativesU(r);
   const std::array<Bernstein2, 3> ruv = derivativesV(ru);  // (m - 1, n - 1)
   const Bernstein2 mixed = dot(ruv, normal);               // (3m - 2, 3n - 2)
   const Bernstein2 mixedSquared = multiply(mixed, mixed);  // (6m - 4, 6n - 4)
-  auto largest = [](const Bernstein2& p) {
-    double out = 0.0;
-    for (double c : p.coefficients) out = std::max(out, std::abs(c));
-    return out;
-  };
   // r_uu (m - 2, n) and r_vv (m, n - 2) vanish identically for m = 1 or n = 1; leaving the
   // product out then keeps the bidegree (6m - 4, 6n - 4) instead of padding it.
   if (patch.degreeU < 2 || patch.degreeV < 2) {
@@ -413,6 +579,7 @@ PatchDerivatives derivativesImpl(const BezierPatch& patch, double u, double v) {
 
 PatchDerivatives derivativesToSecondOrder(const BezierPatch& patch, double u, double v) {
   requireValid(patch, "derivativesToSecondOrder");
+  if (patch.rational()) return rationalDerivatives(patch, u, v, nullptr);
   if (patch.degreeU == 3 && patch.degreeV == 3) return derivativesImpl<3, 3>(patch, u, v);
   return derivativesImpl<>(patch, u, v);
 }

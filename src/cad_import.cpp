@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <mutex>
 #include <string>
 #include <utility>
@@ -18,6 +19,7 @@
 
 #include <BRepTools.hxx>
 #include <BRep_Tool.hxx>
+#include <GeomAPI_ProjectPointOnSurf.hxx>
 #include <GeomAdaptor_Surface.hxx>
 #include <GeomConvert.hxx>
 #include <GeomConvert_BSplineSurfaceToBezierSurface.hxx>
@@ -369,6 +371,22 @@ void checkConversion(const Handle(Geom_Surface)& original, const Handle(Geom_BSp
       const gp_Pnt got = spline->Value(su0 + s * (su1 - su0), sv0 + t * (sv1 - sv0));
       worst = std::max(worst, expected.Distance(got));
     }
+  if (!(worst <= kConversionTolerance * size) && spline->IsURational() + spline->IsVRational() > 0) {
+    // A rational conversion (conics: OCCT's circles are parametrised by tan(theta / 2), not
+    // by theta) may reparametrise the surface: the same point set is then the test, each
+    // side's samples within the tolerance of the other surface (projected onto it).
+    worst = 0.0;
+    const auto distanceTo = [](const gp_Pnt& point, const Handle(Geom_Surface)& surface) {
+      GeomAPI_ProjectPointOnSurf projection(point, surface);
+      return projection.NbPoints() > 0 ? projection.LowerDistance() : std::numeric_limits<double>::infinity();
+    };
+    for (int a = 0; a < kConversionSamples; ++a)
+      for (int b = 0; b < kConversionSamples; ++b) {
+        const double s = (a + 0.5) / kConversionSamples, t = (b + 0.5) / kConversionSamples;
+        worst = std::max({worst, distanceTo(spline->Value(su0 + s * (su1 - su0), sv0 + t * (sv1 - sv0)), original),
+                          distanceTo(original->Value(r.u0 + s * (r.u1 - r.u0), r.v0 + t * (r.v1 - r.v0)), spline)});
+      }
+  }
   if (!(worst <= kConversionTolerance * size))
     throw FaceRefused{CadFaceIssue::unsupportedSurface,
                       fmt::format("is {}, whose conversion to a B-spline is not exact (off by {:.3g}, {:.3g} of its size): not supported",
@@ -381,7 +399,7 @@ struct Stage {
   std::optional<Rectangle> rectangle;  // once known
 };
 
-std::vector<BezierPatch> facePatches(const TopoDS_Face& face, Units units, Stage& stage) {
+std::vector<BezierPatch> facePatches(const TopoDS_Face& face, Units units, Stage& stage, bool acceptRational) {
   const Handle(Geom_Surface) located = BRep_Tool::Surface(face);  // the face's location applied
   if (located.IsNull()) throw FaceRefused{CadFaceIssue::unsupportedSurface, "has no surface"};
   const Handle(Geom_Surface) basis = exactBasis(located);
@@ -405,7 +423,7 @@ std::vector<BezierPatch> facePatches(const TopoDS_Face& face, Units units, Stage
       range.min = std::min(range.min, w.min);
       range.max = std::max(range.max, w.max);
     }
-  if (!polynomial)
+  if (!polynomial && !acceptRational)
     throw FaceRefused{CadFaceIssue::rational,
                       fmt::format("is rational (weights {:.6g} to {:.6g}, {}): rational faces are not supported yet",
                                   range.min, range.max, surfaceKind(basis))};
@@ -426,6 +444,7 @@ std::vector<BezierPatch> facePatches(const TopoDS_Face& face, Units units, Stage
           // Reversing u flips r_u and so r_u x r_v: the normal then points out of the material.
           const gp_Pnt& p = piece->Pole(reversed ? patch.degreeU - a + 1 : a + 1, b + 1);
           patch.control.push_back({p.X(), p.Y(), p.Z()});
+          if (!polynomial) patch.weights.push_back(piece->Weight(reversed ? patch.degreeU - a + 1 : a + 1, b + 1));
         }
       patches.push_back(std::move(patch));
     }
@@ -485,7 +504,7 @@ CadImport convertFaces(const CadFile& transferred, const std::string& path, cons
       std::vector<BezierPatch> patches;
       Stage stage;
       try {
-        patches = facePatches(face, transferred.units, stage);
+        patches = facePatches(face, transferred.units, stage, options.acceptRational);
       } catch (const Standard_Failure& failure) {
         throw FaceRefused{CadFaceIssue::unsupportedSurface,
                           fmt::format("could not be converted: OpenCASCADE failed {}{} ({})", stage.what,

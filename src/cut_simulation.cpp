@@ -486,6 +486,7 @@ HeightGrid gridOver(const XyBox& box, const SimulationOptions& options) {
 }  // namespace
 
 HeightGrid simulationGrid(const Surface& surface, const SimulationOptions& options) {
+  requirePolynomial(surface, "the simulated cut");
   validateOptions(options);
   if (surface.patches.empty()) throw Error("the surface has no patches");
   XyBox box;
@@ -514,6 +515,7 @@ HeightGrid simulationGrid(Vec2 low, Vec2 high, const SimulationOptions& options)
 }
 
 void designHeights(const Surface& surface, HeightGrid& grid, std::vector<double>* normalZ) {
+  requirePolynomial(surface, "the simulated cut");
   std::fill(grid.z.begin(), grid.z.end(), -kInf);
   if (normalZ) normalZ->assign(grid.z.size(), 0.0);
   const double tolerance = 1e-12 * std::max(surfaceScale(surface), 1e-300);

@@ -1115,6 +1115,7 @@ std::vector<Segment> segmentsOf(const ToolPath& path) {
 SurfaceDistance::SurfaceDistance(const Surface& surface, const DistanceOptions& options)
     : surface_(surface), options_(options) {
   checkSurface(surface_);
+  requirePolynomial(surface_, "the ball-to-surface distance");
   if (!(options.tolerance >= 0.0) || !std::isfinite(options.tolerance)) {
     throw Error(fmt::format("surface distance: the tolerance must be finite and >= 0, got {}",
                             options.tolerance));

@@ -402,6 +402,7 @@ void joinPieces(std::vector<Piece> pieces, double joinTolerance, PlaneSection& o
 
 PlaneSection planeSection(const Surface& surface, const Vec3& normal, double offset,
                           double chordalTolerance) {
+  requirePolynomial(surface, "plane sections");
   const double length = norm(normal);
   if (!std::isfinite(length) || length == 0.0)
     throw Error(fmt::format("plane section: the plane normal ({}, {}, {}) must be finite and non-zero",

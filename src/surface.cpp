@@ -113,6 +113,27 @@ double patchScale(const BezierPatch& patch) {
 double derivativeBoundProduct(const BezierPatch& patch) {
   const int m = patch.degreeU;
   const int n = patch.degreeV;
+  if (patch.rational()) {
+    // N = w X_u x X_v - w_v X_u x X - w_u X x X_v (bezier.hpp): each term's factors bounded
+    // by their nets (hodographs m dX, m dw; X and w themselves), summed.
+    double x = 0.0, w = 0.0, dxu = 0.0, dxv = 0.0, dwu = 0.0, dwv = 0.0;
+    for (int j = 0; j <= m; ++j) {
+      for (int k = 0; k <= n; ++k) {
+        const Vec3 h = patch.weight(j, k) * patch.at(j, k);
+        x = std::max(x, norm(h));
+        w = std::max(w, patch.weight(j, k));
+        if (j < m) {
+          dxu = std::max(dxu, norm(patch.weight(j + 1, k) * patch.at(j + 1, k) - h));
+          dwu = std::max(dwu, std::abs(patch.weight(j + 1, k) - patch.weight(j, k)));
+        }
+        if (k < n) {
+          dxv = std::max(dxv, norm(patch.weight(j, k + 1) * patch.at(j, k + 1) - h));
+          dwv = std::max(dwv, std::abs(patch.weight(j, k + 1) - patch.weight(j, k)));
+        }
+      }
+    }
+    return w * (m * dxu) * (n * dxv) + (n * dwv) * (m * dxu) * x + (m * dwu) * x * (n * dxv);
+  }
   double du = 0.0;
   double dv = 0.0;
   for (int j = 0; j <= m; ++j) {
@@ -197,6 +218,14 @@ BezierPatch scaledToUnit(const BezierPatch& original) {
   BezierPatch patch = original;
   for (Vec3& p : patch.control) {
     p = {std::ldexp(p.x, -exponent), std::ldexp(p.y, -exponent), std::ldexp(p.z, -exponent)};
+  }
+  // A rational patch's weights likewise, largest in [0.5, 1) (the surface is unchanged:
+  // weights matter only up to a common factor), so that its N = w^3 r_u x r_v is of the
+  // polynomial case's size.
+  if (patch.rational()) {
+    int weightExponent = 0;
+    std::frexp(*std::max_element(patch.weights.begin(), patch.weights.end()), &weightExponent);
+    for (double& w : patch.weights) w = std::ldexp(w, -weightExponent);
   }
   return patch;
 }
@@ -559,6 +588,26 @@ void validatePatch(const BezierPatch& patch, std::size_t index) {
       }
     }
   }
+  if (patch.rational()) {
+    if (patch.weights.size() != expected)
+      throw Error(fmt::format("{}.weights: degree [{}, {}] needs {} weights, got {}", where, patch.degreeU,
+                              patch.degreeV, expected, patch.weights.size()));
+    double least = std::numeric_limits<double>::infinity(), largest = 0.0;
+    for (int j = 0; j <= patch.degreeU; ++j) {
+      for (int k = 0; k <= patch.degreeV; ++k) {
+        const double w = patch.weight(j, k);
+        if (!(w > 0.0) || !std::isfinite(w))
+          throw Error(fmt::format("{}.weights[{}][{}]: a weight must be positive and finite, got {}", where, j, k, w));
+        least = std::min(least, w);
+        largest = std::max(largest, w);
+      }
+    }
+    // The rational polynomials multiply up to ten weights: a spread beyond this would lose
+    // the small ones to rounding (CAD's conics have sqrt(2)/2 to 1).
+    if (largest > kMaxWeightRatio * least)
+      throw Error(fmt::format("{}.weights: they range from {:g} to {:g}, a ratio above {:g}", where, least, largest,
+                              kMaxWeightRatio));
+  }
   const double scale = patchScale(patch);
   if (scale > kMaxPatchScale || (scale > 0.0 && scale < kMinPatchScale)) {
     throw Error(fmt::format("{}: the largest |coordinate| is {:g}, outside [{:g}, {:g}] where the "
@@ -675,7 +724,7 @@ BezierPatch parsePatch(const Json& value, std::size_t index, const std::string& 
          fmt::format("expected an object {{\"degree\": [m, n], \"control_points\": [...]}}, got {}",
                      quoted(value)));
   }
-  rejectUnknownKeys(value, {"degree", "control_points"}, source, where);
+  rejectUnknownKeys(value, {"degree", "control_points", "weights"}, source, where);
   if (!value.contains("degree")) fail(source, where, "missing \"degree\": [m, n]");
   if (!value.contains("control_points")) fail(source, where, "missing \"control_points\"");
 
@@ -717,6 +766,30 @@ BezierPatch parsePatch(const Json& value, std::size_t index, const std::string& 
     }
     for (std::size_t k = 0; k < columns; ++k) {
       patch.control.push_back(parsePoint(row[k], source, fmt::format("{}[{}]", rowWhere, k)));
+    }
+  }
+  // Optional: a rational patch's weights, rows of numbers as the control points' (bezier.hpp).
+  if (value.contains("weights")) {
+    const Json& weights = value["weights"];
+    const std::string weightsWhere = where + ".weights";
+    if (!weights.is_array() || weights.size() != rows)
+      fail(source, weightsWhere,
+           fmt::format("degree [{}, {}] needs m + 1 = {} rows of {} weights, got {}", patch.degreeU, patch.degreeV,
+                       rows, columns, quoted(weights)));
+    patch.weights.reserve(rows * columns);
+    for (std::size_t j = 0; j < rows; ++j) {
+      const Json& row = weights[j];
+      const std::string rowWhere = fmt::format("{}[{}]", weightsWhere, j);
+      if (!row.is_array() || row.size() != columns)
+        fail(source, rowWhere, fmt::format("expected a row of {} weights, got {}", columns, quoted(row)));
+      for (std::size_t k = 0; k < columns; ++k) {
+        if (!row[k].is_number())
+          fail(source, fmt::format("{}[{}]", rowWhere, k), fmt::format("expected a number, got {}", quoted(row[k])));
+        const double w = row[k].get<double>();
+        if (!(w > 0.0) || !std::isfinite(w))
+          fail(source, fmt::format("{}[{}]", rowWhere, k), fmt::format("a weight must be positive, got {}", w));
+        patch.weights.push_back(w);
+      }
     }
   }
   return patch;
@@ -825,6 +898,15 @@ void validateSurface(const Surface& surface, const std::string& sourceName) {
   }
 }
 
+void requirePolynomial(const Surface& surface, std::string_view what) {
+  for (std::size_t i = 0; i < surface.patches.size(); ++i)
+    if (surface.patches[i].rational())
+      throw Error(fmt::format("{} is rational, and {} is for polynomial patches only yet (scallop orient takes "
+                              "rational patches; plan and paths take a STEP or IGES part's rational faces through "
+                              "its tessellation)",
+                              patchPath(i), what));
+}
+
 void validateSurface(const Surface& surface) {
   if (surface.patches.empty()) throw Error("patches: no patches; a surface needs at least one");
   for (std::size_t i = 0; i < surface.patches.size(); ++i) validatePatch(surface.patches[i], i);
@@ -881,7 +963,21 @@ std::string surfaceToJson(const Surface& surface) {
       }
       out += "]";
     }
-    out += "\n      ]\n    }";
+    out += "\n      ]";
+    if (patch.rational()) {
+      if (patch.weights.size() != patch.control.size() ||
+          !std::all_of(patch.weights.begin(), patch.weights.end(), [](double w) { return std::isfinite(w); }))
+        throw Error(fmt::format("surfaceToJson: {}: {} weights for {} control points{} cannot be written",
+                                patchPath(i), patch.weights.size(), patch.control.size(), " (or not all finite)"));
+      out += ",\n      \"weights\": [";
+      for (int j = 0; j <= patch.degreeU; ++j) {
+        out += j == 0 ? "\n        [" : ",\n        [";
+        for (int k = 0; k <= patch.degreeV; ++k) out += fmt::format("{}{}", k == 0 ? "" : ", ", shortest(patch.weight(j, k)));
+        out += "]";
+      }
+      out += "\n      ]";
+    }
+    out += "\n    }";
   }
   out += surface.patches.empty() ? "]\n}\n" : "\n  ]\n}\n";
   return out;

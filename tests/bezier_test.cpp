@@ -885,3 +885,189 @@ TEST(BezierErrors, InvalidPatchesAndOrdersThrow) {
 }
 
 }  // namespace
+
+// --- rational patches (the contract's Rational patches) ------------------------------------
+
+namespace {
+
+// A patch of the torus (sqrt(x^2 + y^2) - a)^2 + z^2 = b^2 as the tensor product of two
+// rational quadratic quarter circles, built here from the surface of revolution's textbook
+// construction (Piegl and Tiller, The NURBS Book, 8.5): the profile's control points
+// (x_k, z_k) with weights v_k swept by the arc's (c_j, weights a_j): p_jk = (x_k c_j, z_k),
+// w_jk = a_j v_k. `outer`: the profile's quarter from (a + b, 0) over the top to (a, b) (K >= 0);
+// otherwise from (a - b, 0) to (a, b) (K <= 0).
+BezierPatch torusPatch(double a, double b, bool outer) {
+  const double s = std::sqrt(0.5);
+  const std::array<std::pair<double, double>, 3> arc{{{1, 0}, {1, 1}, {0, 1}}};
+  const std::array<double, 3> arcWeights{1, s, 1};
+  const double x0 = outer ? a + b : a - b;
+  const std::array<std::pair<double, double>, 3> profile{{{x0, 0}, {x0, b}, {a, b}}};
+  BezierPatch patch;
+  patch.degreeU = patch.degreeV = 2;
+  for (int j = 0; j <= 2; ++j)
+    for (int k = 0; k <= 2; ++k) {
+      patch.control.push_back({profile[k].first * arc[j].first, profile[k].first * arc[j].second, profile[k].second});
+      patch.weights.push_back(arcWeights[j] * arcWeights[k]);
+    }
+  return patch;
+}
+
+BezierPatch randomRationalPatch(std::mt19937_64& rng, int m, int n) {
+  std::uniform_real_distribution<double> coordinate(-1.0, 1.0), weight(0.3, 3.0);
+  BezierPatch patch;
+  patch.degreeU = m;
+  patch.degreeV = n;
+  for (int j = 0; j <= m; ++j)
+    for (int k = 0; k <= n; ++k) {
+      // A bumpy graph over the unit square keeps the patch regular.
+      patch.control.push_back({double(j) / m + 0.1 * coordinate(rng), double(k) / n + 0.1 * coordinate(rng),
+                               0.5 * coordinate(rng)});
+      patch.weights.push_back(weight(rng));
+    }
+  return patch;
+}
+
+}  // namespace
+
+TEST(BezierRational, TorusPatchesLieOnTheTorusWithTheirCurvatureSign) {
+  const double a = 3.0, b = 1.0;
+  for (const bool outer : {true, false}) {
+    const BezierPatch patch = torusPatch(a, b, outer);
+    const Bernstein2 curvature = scallop::gaussianCurvatureNumerator(patch);
+    const std::array<Bernstein2, 3> normal = scallop::normalPolynomials(patch);
+    for (int i = 0; i <= 20; ++i)
+      for (int k = 0; k <= 20; ++k) {
+        const double u = i / 20.0, v = k / 20.0;
+        const Vec3 p = scallop::point(patch, u, v);
+        EXPECT_NEAR(std::pow(std::hypot(p.x, p.y) - a, 2) + p.z * p.z, b * b, 1e-13) << u << ", " << v;
+        // The unit normal is the tube's: along p minus the nearest point of the core circle.
+        const double rho = std::hypot(p.x, p.y);
+        const Vec3 radial = Vec3{p.x - a * p.x / rho, p.y - a * p.y / rho, p.z} / b;
+        const Vec3 n = scallop::unitNormal(patch, u, v);
+        EXPECT_NEAR(std::abs(dot(n, radial)), 1.0, 1e-12) << u << ", " << v;
+        const Vec3 q{scallop::evaluate(normal[0], u, v), scallop::evaluate(normal[1], u, v),
+                     scallop::evaluate(normal[2], u, v)};
+        EXPECT_NEAR(dot(q, n) / norm(q), 1.0, 1e-12) << "normal polynomial's direction at " << u << ", " << v;
+        // K = cos(phi) / (b (a + b cos(phi))), cos(phi) = (rho - a) / b: its sign.
+        const double cosPhi = (rho - a) / b;
+        const double sign = scallop::evaluate(curvature, u, v);
+        if (std::abs(cosPhi) > 1e-6) {
+          EXPECT_EQ(sign > 0.0, cosPhi > 0.0) << u << ", " << v << ": " << sign;
+        }
+      }
+  }
+}
+
+TEST(BezierRational, RandomPatchesDerivativesNormalAndCurvatureAgainstIndependentReferences) {
+  std::mt19937_64 rng(20261127);
+  for (int trial = 0; trial < 300; ++trial) {
+    const int m = 1 + trial % 4, n = 1 + (trial / 4) % 4;
+    const BezierPatch patch = randomRationalPatch(rng, m, n);
+    // The reference point: the defining sums, in long double.
+    const auto reference = [&](double u, double v) {
+      Real x = 0, y = 0, z = 0, w = 0;
+      for (int j = 0; j <= m; ++j)
+        for (int k = 0; k <= n; ++k) {
+          Real bj = 1, bk = 1;
+          for (int i = 0; i < j; ++i) bj *= Real(m - i) / Real(i + 1);
+          for (int i = 0; i < k; ++i) bk *= Real(n - i) / Real(i + 1);
+          bj *= std::pow(Real(u), j) * std::pow(Real(1 - u), m - j);
+          bk *= std::pow(Real(v), k) * std::pow(Real(1 - v), n - k);
+          const Real c = bj * bk * patch.weight(j, k);
+          x += c * patch.at(j, k).x, y += c * patch.at(j, k).y, z += c * patch.at(j, k).z, w += c;
+        }
+      return std::array<Real, 3>{x / w, y / w, z / w};
+    };
+    std::uniform_real_distribution<double> parameter(0.05, 0.95);
+    const double u = parameter(rng), v = parameter(rng), h = 1e-4;
+    const auto at = [&](double uu, double vv) {
+      const auto r = reference(uu, vv);
+      return std::array<Real, 3>{r[0], r[1], r[2]};
+    };
+    const Vec3 p = scallop::point(patch, u, v);
+    const auto r0 = at(u, v);
+    EXPECT_NEAR(p.x, double(r0[0]), 1e-13);
+    EXPECT_NEAR(p.y, double(r0[1]), 1e-13);
+    EXPECT_NEAR(p.z, double(r0[2]), 1e-13);
+    // Central differences of the reference (error O(h^2) with a quotient's derivatives ~ 1e2).
+    const auto difference = [&](int du, int dv) {
+      Vec3 out;
+      double c[3];
+      for (int i = 0; i < 3; ++i) {
+        Real value;
+        if (du == 1 && dv == 0) value = (at(u + h, v)[i] - at(u - h, v)[i]) / (2 * h);
+        else if (du == 0 && dv == 1) value = (at(u, v + h)[i] - at(u, v - h)[i]) / (2 * h);
+        else if (du == 2) value = (at(u + h, v)[i] - 2 * at(u, v)[i] + at(u - h, v)[i]) / (h * h);
+        else if (dv == 2) value = (at(u, v + h)[i] - 2 * at(u, v)[i] + at(u, v - h)[i]) / (h * h);
+        else value = (at(u + h, v + h)[i] - at(u + h, v - h)[i] - at(u - h, v + h)[i] + at(u - h, v - h)[i]) / (4 * h * h);
+        c[i] = double(value);
+      }
+      out = {c[0], c[1], c[2]};
+      return out;
+    };
+    const scallop::PatchDerivatives d = scallop::derivativesToSecondOrder(patch, u, v);
+    const auto near = [&](Vec3 a, Vec3 b, double tolerance, const char* what) {
+      EXPECT_LE(norm(a - b), tolerance * (1.0 + norm(b))) << what << " trial " << trial;
+    };
+    near(scallop::derivativeU(patch, u, v), difference(1, 0), 1e-5, "r_u");
+    near(scallop::derivativeV(patch, u, v), difference(0, 1), 1e-5, "r_v");
+    near(d.u, scallop::derivativeU(patch, u, v), 1e-14, "r_u in one pass");
+    near(d.uu, difference(2, 0), 1e-3, "r_uu");
+    near(d.uv, difference(1, 1), 1e-3, "r_uv");
+    near(d.vv, difference(0, 2), 1e-3, "r_vv");
+    near(scallop::secondDerivative(patch, u, v, 1, 1), d.uv, 1e-14, "r_uv alone");
+    // N's direction and K's sign from the polynomials against the derivatives at the point:
+    // N = w^3 r_u x r_v and the curvature polynomial = w^10 (r_uu . n)(r_vv . n) - (r_uv . n)^2.
+    const std::array<Bernstein2, 3> normal = scallop::normalPolynomials(patch);
+    const double w = scallop::evaluate(scallop::homogeneousPolynomials(patch)[3], u, v);
+    const Vec3 cross = scallop::cross(d.u, d.v);
+    const Vec3 q{scallop::evaluate(normal[0], u, v), scallop::evaluate(normal[1], u, v),
+                 scallop::evaluate(normal[2], u, v)};
+    near(q, w * w * w * cross, 1e-11, "N = w^3 r_u x r_v");
+    const double pointwise = scallop::gaussianCurvatureNumeratorAt(patch, u, v);
+    const double polynomial = scallop::evaluate(scallop::gaussianCurvatureNumerator(patch), u, v);
+    EXPECT_NEAR(polynomial, std::pow(w, 10) * pointwise, 1e-9 * (1.0 + std::abs(std::pow(w, 10) * pointwise)))
+        << "trial " << trial;
+    EXPECT_NEAR(scallop::evaluate(scallop::normalLengthSquared(patch), u, v), dot(q, q), 1e-11 * (1.0 + dot(q, q)));
+    // A sub-patch is the patch, reparametrised.
+    const BezierPatch piece = scallop::restrictTo(patch, 0.2, 0.7, 0.1, 0.9);
+    ASSERT_TRUE(piece.rational());
+    for (const double s : {0.0, 0.3, 1.0})
+      near(scallop::point(piece, s, s), scallop::point(patch, 0.2 + 0.5 * s, 0.1 + 0.8 * s), 1e-13, "sub-patch");
+  }
+}
+
+TEST(BezierRational, EqualWeightsAreThePolynomialPatch) {
+  std::mt19937_64 rng(7);
+  for (int trial = 0; trial < 50; ++trial) {
+    BezierPatch rational = randomRationalPatch(rng, 1 + trial % 3, 1 + trial % 4);
+    BezierPatch polynomial = rational;
+    polynomial.weights.clear();
+    rational.weights.assign(rational.weights.size(), 2.5);
+    for (const double u : {0.0, 0.31, 1.0})
+      for (const double v : {0.0, 0.77, 1.0}) {
+        EXPECT_LE(norm(scallop::point(rational, u, v) - scallop::point(polynomial, u, v)), 1e-15);
+        EXPECT_LE(norm(scallop::unitNormal(rational, u, v) - scallop::unitNormal(polynomial, u, v)), 1e-13);
+        const double kr = scallop::gaussianCurvatureNumeratorAt(rational, u, v);
+        const double kp = scallop::gaussianCurvatureNumeratorAt(polynomial, u, v);
+        EXPECT_NEAR(kr, kp, 1e-12 * (1.0 + std::abs(kp)));
+      }
+  }
+}
+
+TEST(BezierRational, BadWeightsAreRefusedByIndex) {
+  BezierPatch patch = torusPatch(3.0, 1.0, true);
+  patch.weights.pop_back();
+  EXPECT_THROW((void)scallop::point(patch, 0.5, 0.5), scallop::Error);
+  for (const double bad : {0.0, -1.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
+    BezierPatch weighted = torusPatch(3.0, 1.0, true);
+    weighted.weights[4] = bad;
+    try {
+      (void)scallop::point(weighted, 0.5, 0.5);
+      ADD_FAILURE() << "weight " << bad << " accepted";
+    } catch (const scallop::Error& error) {
+      EXPECT_NE(std::string(error.what()).find("weight 4"), std::string::npos) << error.what();
+    }
+  }
+  EXPECT_THROW((void)scallop::coordinatePolynomials(torusPatch(3.0, 1.0, true)), scallop::Error);
+}

@@ -472,6 +472,43 @@ TEST_F(CadCli, OrientAndPlanTakeAStepFile) {
   EXPECT_TRUE(fs::exists(workDir_ / "out" / "toolpath.ngc"));
 }
 
+// orient takes a rational face exactly (bezier.hpp's rational patches): a quarter of a
+// cylinder's side (radius 2, axis z, 1 rad of it, 5 long) has horizontal normals only, on one
+// arc of the equator: alpha* = 90 deg at N* = z, certified. plan takes it through its
+// tessellation (rational patches are orient's only yet).
+TEST_F(CadCli, OrientTakesARationalFaceExactly) {
+  const Handle(Geom_CylindricalSurface) cylinder = new Geom_CylindricalSurface(gp_Ax3(), 2.0);
+  writeStep(BRepBuilderAPI_MakeFace(cylinder, 0.0, 1.0, 0.0, 5.0, Precision::Confusion()).Face(),
+            workDir_ / "cylinder.step", "MM");
+  const scallop::test::RunResult orient = run("orient cylinder.step");
+  ASSERT_EQ(orient.exitCode, 0) << orient.err;
+  EXPECT_NE(orient.err.find("STEP, 1 faces -> "), std::string::npos) << orient.err;
+  const auto json = nlohmann::json::parse(orient.out);
+  EXPECT_NEAR(json["alpha_deg"].get<double>(), 90.0, 1e-9);
+  EXPECT_TRUE(json["certified"].get<bool>());
+  EXPECT_NEAR(std::abs(json["normal"][2].get<double>()), 1.0, 1e-9);
+  // The patches are the cylinder exactly: every point at distance 2 from the axis.
+  scallop::CadImportOptions options;
+  options.acceptRational = true;
+  const CadImport imported = scallop::importCad((workDir_ / "cylinder.step").string(), options);
+  ASSERT_FALSE(imported.surface.patches.empty());
+  for (const BezierPatch& patch : imported.surface.patches) {
+    EXPECT_TRUE(patch.rational());
+    for (int i = 0; i <= 10; ++i)
+      for (int j = 0; j <= 10; ++j) {
+        const Vec3 p = scallop::point(patch, i / 10.0, j / 10.0);
+        EXPECT_NEAR(std::hypot(p.x, p.y), 2.0, 1e-12);
+        EXPECT_GE(p.z, -1e-12);
+        EXPECT_LE(p.z, 5.0 + 1e-12);
+      }
+  }
+  EXPECT_THROW((void)scallop::importCad((workDir_ / "cylinder.step").string()), scallop::Error);  // not by default
+  const scallop::test::RunResult plan = run("plan cylinder.step --tool-radius 0.5 --scallop-height 0.05 --out out --quiet");
+  ASSERT_EQ(plan.exitCode, 0) << plan.err;
+  const auto report = nlohmann::json::parse(scallop::test::readFile(workDir_ / "out" / "report.json"));
+  EXPECT_EQ(report["tessellation"]["design"], "exact faces");
+}
+
 TEST_F(CadCli, BadFilesFailCleanly) {
   write("empty.step", "");
   expectCleanFailure(run("orient empty.step"), {"empty.step", "empty"}, "empty.step");
@@ -483,9 +520,9 @@ TEST_F(CadCli, BadFilesFailCleanly) {
   const Handle(Geom_CylindricalSurface) cylinder = new Geom_CylindricalSurface(gp_Ax3(), 2.0);
   writeStep(BRepBuilderAPI_MakeFace(cylinder, 0.0, 1.0, 0.0, 5.0, Precision::Confusion()).Face(),
             workDir_ / "cylinder.step", "MM");
-  // Every command takes such a part through its tessellation; asked for the exact faces alone,
-  // none is left, and the message says why.
-  expectCleanFailure(run("orient cylinder.step --skip-faces --json out.json"),
+  // plan and paths take such a part through its tessellation (orient takes rational faces
+  // exactly); asked for the exact faces alone, none is left, and the message says why.
+  expectCleanFailure(run("paths cylinder.step --skip-faces --tool-radius 1 --scallop-height 0.01 --json out.json"),
                      {"cylinder.step", "none of its 1 faces", "face 0", "rational"}, "cylinder.step");
   expectCleanFailure(run("plan cylinder.step --skip-faces --out out"), {"cylinder.step", "none of its 1 faces"},
                      "cylinder.step");

@@ -965,3 +965,86 @@ TEST(OptimalSlicing, SingularCornersMatchBruteForce) {
               "%.5f deg better on the continuous surface\n",
               tested, agreeing, worstGap / kDeg);
 }
+
+// --- rational patches (bezier.hpp's Rational patches; issue 14, item 2) -------------------
+
+namespace {
+
+// The surface of revolution's textbook construction (Piegl and Tiller, The NURBS Book, 8.5):
+// a rational quadratic profile (x_k, z_k; weights 1, sqrt(2)/2, 1) swept by a quarter
+// circle: p_jk = (x_k c_j, z_k), w_jk = a_j v_k.
+Surface quarterRevolution(const std::array<std::pair<double, double>, 3>& profile) {
+  const double s = std::sqrt(0.5);
+  const std::array<std::pair<double, double>, 3> arc{{{1, 0}, {1, 1}, {0, 1}}};
+  const std::array<double, 3> weights{1, s, 1};
+  BezierPatch patch;
+  patch.degreeU = patch.degreeV = 2;
+  patch.control.clear();
+  for (int j = 0; j <= 2; ++j)
+    for (int k = 0; k <= 2; ++k) {
+      patch.control.push_back({profile[k].first * arc[j].first, profile[k].first * arc[j].second, profile[k].second});
+      patch.weights.push_back(weights[j] * weights[k]);
+    }
+  return Surface{scallop::Units::millimetre, {patch}};
+}
+
+}  // namespace
+
+// Closed forms: a sphere's octant (its pole row collapsed), the outer and the inner quarter
+// of a torus's quarter: each patch's normals fill one octant of the sphere (and, symmetrized,
+// its antipode), whose farthest direction stands 45 deg from both: alpha* = 45 deg exactly,
+// certified, and the brute force agrees.
+TEST(OptimalSlicingRational, SphereOctantAndTorusQuartersGiveFortyFiveDegrees) {
+  const std::array<std::array<std::pair<double, double>, 3>, 3> profiles{{
+      {{{2, 0}, {2, 2}, {0, 2}}},  // sphere of radius 2: equator to pole
+      {{{4, 0}, {4, 1}, {3, 1}}},  // torus (3, 1), outer quarter
+      {{{2, 0}, {2, 1}, {3, 1}}},  // torus (3, 1), inner quarter
+  }};
+  for (std::size_t i = 0; i < profiles.size(); ++i) {
+    SCOPED_TRACE("profile " + std::to_string(i));
+    const Surface surface = quarterRevolution(profiles[i]);
+    scallop::validateSurface(surface);
+    const scallop::OptimalSlicing result = scallop::optimalSlicing(surface);
+    EXPECT_NEAR(result.alphaRad / kDeg, 45.0, 1e-9);
+    EXPECT_TRUE(result.certified);
+    EXPECT_GE(result.certifiedAlphaRad / kDeg, 45.0 - 1e-3);
+    EXPECT_LE(result.certifiedAlphaRad, result.alphaRad + 1e-15);
+    EXPECT_NEAR(std::abs(result.normal.z), std::sqrt(0.5), 1e-6);
+    expectAsGoodAsBruteForce(surface, 0.5);
+  }
+}
+
+// Random rational graph patches (bicubic nets over a 3 x 3 footprint as the paper's, weights
+// in [0.4, 2.5]): N* as good as the brute force over the same rational normals, certified,
+// and the certificate's claim true on dense samples.
+TEST(OptimalSlicingRational, RandomRationalGraphPatchesAgainstBruteForce) {
+  std::mt19937_64 rng(20261127);
+  std::uniform_real_distribution<double> weight(0.4, 2.5);
+  int tested = 0;
+  while (tested < 6) {
+    Surface s = randomGraphSurface(rng, tested % 2 == 0 ? 1.5 : 0.6, scallop::Units::inch);
+    for (std::size_t k = 0; k < s.patches[0].control.size(); ++k) s.patches[0].weights.push_back(weight(rng));
+    try {
+      scallop::validateSurface(s);
+    } catch (const scallop::Error&) {
+      continue;
+    }
+    SCOPED_TRACE("rational patch " + std::to_string(tested));
+    expectAsGoodAsBruteForce(s, 0.5);
+    ++tested;
+  }
+}
+
+// Equal weights are the polynomial patch: the same answer to rounding.
+TEST(OptimalSlicingRational, EqualWeightsGiveThePolynomialAnswer) {
+  std::mt19937_64 rng(11);
+  for (int trial = 0; trial < 3; ++trial) {
+    Surface polynomial = randomGraphSurface(rng, 1.5, scallop::Units::inch);
+    Surface rational = polynomial;
+    rational.patches[0].weights.assign(rational.patches[0].control.size(), 0.75);
+    const scallop::OptimalSlicing a = scallop::optimalSlicing(polynomial), b = scallop::optimalSlicing(rational);
+    EXPECT_NEAR(a.alphaRad, b.alphaRad, 1e-9);
+    EXPECT_NEAR(std::abs(scallop::dot(a.normal, b.normal)), 1.0, 1e-9);
+    EXPECT_EQ(a.certified, b.certified);
+  }
+}

@@ -175,6 +175,41 @@ TEST_F(OrientCli, WritesJsonAndFiguresAndFindsThePapersOptimum) {
   }
 }
 
+// A rational patch in the surface JSON (weights): a torus's outer quarter, whose normals
+// fill an octant of the sphere: alpha* = 45 deg, certified. The commands that take
+// polynomial patches only refuse it in one line, naming the patch.
+TEST_F(OrientCli, TakesARationalPatchAndOtherCommandsRefuseIt) {
+  const double s = std::sqrt(0.5);
+  Json patch;
+  patch["degree"] = {2, 2};
+  Json points = Json::array(), weights = Json::array();
+  const double arc[3][2] = {{1, 0}, {1, 1}, {0, 1}}, profile[3][2] = {{4, 0}, {4, 1}, {3, 1}};
+  const double w[3] = {1, s, 1};
+  for (int j = 0; j < 3; ++j) {
+    Json row = Json::array(), weightRow = Json::array();
+    for (int k = 0; k < 3; ++k) {
+      row.push_back({profile[k][0] * arc[j][0], profile[k][0] * arc[j][1], profile[k][1]});
+      weightRow.push_back(w[j] * w[k]);
+    }
+    points.push_back(row);
+    weights.push_back(weightRow);
+  }
+  patch["control_points"] = points;
+  patch["weights"] = weights;
+  write("torus.json", Json{{"units", "mm"}, {"patches", {patch}}}.dump());
+  const RunResult orient = run("orient torus.json");
+  ASSERT_EQ(orient.exitCode, 0) << orient.err;
+  const Json json = Json::parse(orient.out);
+  EXPECT_NEAR(json["alpha_deg"].get<double>(), 45.0, 1e-9);
+  EXPECT_TRUE(json["certified"].get<bool>());
+  EXPECT_GE(json["certified_alpha_deg"].get<double>(), 45.0 - 1e-3);
+  for (const char* command : {"paths torus.json --tool-radius 1 --scallop-height 0.01 --json p.json",
+                              "plan torus.json --out out"}) {
+    expectCleanFailure(run(command), {"torus.json", "patches[0] is rational", "orient takes rational patches"},
+                       "torus.json");
+  }
+}
+
 TEST_F(OrientCli, JsonGoesToStandardOutputByDefault) {
   const RunResult result = run("orient --example paper-1 --tolerance 1 --no-certify");
   ASSERT_EQ(result.exitCode, 0) << result.err;

@@ -223,6 +223,26 @@ TEST(Surface, JsonRoundTripIsBitwise) {
   }
 }
 
+TEST(Surface, RationalPatchesRoundTripBitwiseWithTheirWeights) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> weight(0.3, 3.0);
+  for (int trial = 0; trial < 50; ++trial) {
+    Surface surface;
+    surface.units = Units::millimetre;
+    BezierPatch patch = randomGraphPatch(rng, 1 + trial % 4, 1 + trial % 3, 2.0);
+    for (std::size_t k = 0; k < patch.control.size(); ++k) patch.weights.push_back(weight(rng));
+    surface.patches.push_back(patch);
+    surface.patches.push_back(randomGraphPatch(rng, 2, 3, 1.0));  // a polynomial one beside it
+    const std::string text = surfaceToJson(surface);
+    EXPECT_NE(text.find("\"weights\""), std::string::npos);
+    const Surface back = parseSurface(text, "rational.json");
+    expectSameSurface(back, surface);
+    ASSERT_EQ(back.patches[0].weights, surface.patches[0].weights);
+    EXPECT_TRUE(back.patches[1].weights.empty());
+    EXPECT_EQ(surfaceToJson(back), text);
+  }
+}
+
 TEST(Surface, JsonLayoutIsOneRowPerLine) {
   Surface surface;
   surface.patches.push_back(makePatch(1, 1, [](int j, int k) {
@@ -380,6 +400,22 @@ TEST(Surface, RejectsMalformedDocumentsNamingTheLocation) {
       {"point a number",
        [](Json& d) { d["patches"][0]["control_points"][0][0] = 0.5; },
        {"s.json: patches[0].control_points[0][0]", "0.5"}},
+      // A rational patch's weights: rows of positive numbers shaped as the control points.
+      {"weights not rows",
+       [](Json& d) { d["patches"][1]["weights"] = 1.0; },
+       {"s.json: patches[1].weights", "4 rows of 4 weights"}},
+      {"a row of weights too short",
+       [](Json& d) { d["patches"][1]["weights"] = Json::array({{1, 1, 1, 1}, {1, 1, 1}, {1, 1, 1, 1}, {1, 1, 1, 1}}); },
+       {"s.json: patches[1].weights[1]", "a row of 4 weights"}},
+      {"a zero weight",
+       [](Json& d) { d["patches"][1]["weights"] = Json::array({{1, 1, 1, 1}, {1, 1, 0, 1}, {1, 1, 1, 1}, {1, 1, 1, 1}}); },
+       {"s.json: patches[1].weights[1][2]", "positive", "0"}},
+      {"a weight that is a string",
+       [](Json& d) { d["patches"][0]["weights"] = Json::array({{1, 1, 1, 1}, {1, 1, 1, 1}, {1, 1, 1, "2"}, {1, 1, 1, 1}}); },
+       {"s.json: patches[0].weights[2][3]", "a number"}},
+      {"weights too far apart",
+       [](Json& d) { d["patches"][0]["weights"] = Json::array({{1, 1, 1, 1}, {1, 1e7, 1, 1}, {1, 1, 1, 1}, {1, 1, 1, 1}}); },
+       {"s.json: patches[0].weights", "ratio"}},
   };
   for (const Rejected& rejected : cases) {
     Json document = validDocument();

@@ -48,6 +48,27 @@
 //         (restrictTo / subdivideU / subdivideV to refine, as the quadtree on the parabolic
 //         lines); mind the rounding of the coefficients (bernstein.hpp) near A = 0.
 // Subdivision: de Casteljau along one parameter (Lane & Riesenfeld 1981), O(mn(m + n)).
+// Rational patches (issue 14, item 2): with weights w_jk > 0 (BezierPatch::weights),
+//         r = X / w, X(u, v) = sum w_jk p_jk b_j b_k, w(u, v) = sum w_jk b_j b_k: every
+//         exact cylinder, cone, sphere and torus. Points and derivatives to second order by
+//         the quotient rule on the homogeneous (X, w) (r_u = (X_u - w_u r) / w, r_uu =
+//         (X_uu - 2 w_u r_u - w_uu r) / w, r_uv = (X_uv - w_u r_v - w_v r_u - w_uv r) / w);
+//         subdivision on the homogeneous net (the weights stay positive). The polynomial
+//         views stay polynomial once the weights are cleared:
+//           normalPolynomials  N = w X_u x X_v - w_v X_u x X - w_u X x X_v = w^3 r_u x r_v
+//                              (the same direction), bidegree (3m - 1, 3n - 1);
+//           gaussianCurvatureNumerator  A B - C^2 with A = w X_uu . N - w_uu X . N,
+//                              B = w X_vv . N - w_vv X . N, C = w X_uv . N - w_uv X . N
+//                              (w^2 r_uu . N = A since r_u . N = 0, and so on): w^4 times
+//                              the polynomial case's, the same sign, bidegree (10m - 4,
+//                              10n - 4);
+//           normalLengthSquared  |N|^2 of that N.
+//         The unit normal's rounding threshold takes S_u = (m max|X_{j+1,k} - X_jk| + m
+//         max|w_{j+1,k} - w_jk| max|p_jk|) / min w (a bound on |r_u| by the quotient rule),
+//         likewise S_v, and the factor (6(m + n) + 16) u. coordinatePolynomials is for
+//         polynomial patches (scallop::Error on a rational one): the modules built on it
+//         (sections, distances, the design heights) take polynomial patches only, and
+//         surface.hpp's validateSurface refuses rational patches unless asked to accept them.
 
 #include <array>
 #include <utility>
@@ -65,6 +86,11 @@ struct BezierPatch {
   std::vector<Vec3> control;
   /// p_jk, unchecked (as std::vector::operator[]).
   const Vec3& at(int j, int k) const { return control[j * (degreeV + 1) + k]; }
+  /// A rational patch's weights w_jk > 0, stored as `control`; empty: polynomial (all 1).
+  std::vector<double> weights{};
+  bool rational() const { return !weights.empty(); }
+  /// w_jk (1 for a polynomial patch), unchecked.
+  double weight(int j, int k) const { return weights.empty() ? 1.0 : weights[j * (degreeV + 1) + k]; }
 };
 
 /// r(u, v), eq. (1).
@@ -103,14 +129,20 @@ std::pair<BezierPatch, BezierPatch> subdivideV(const BezierPatch& patch, double 
 /// The sub-patch (s, r) -> r(u0 + (u1 - u0) s, v0 + (v1 - v0) r).
 BezierPatch restrictTo(const BezierPatch& patch, double u0, double u1, double v0, double v1);
 
-/// x(u, v), y(u, v), z(u, v) in Bernstein form, bidegree (m, n).
+/// x(u, v), y(u, v), z(u, v) in Bernstein form, bidegree (m, n); scallop::Error for a rational
+/// patch (its coordinates are quotients).
 std::array<Bernstein2, 3> coordinatePolynomials(const BezierPatch& patch);
-/// The components of N = r_u x r_v, bidegree (2m - 1, 2n - 1).
+/// The components of N = r_u x r_v, bidegree (2m - 1, 2n - 1); of a rational patch,
+/// w^3 r_u x r_v (see the contract), bidegree (3m - 1, 3n - 1).
 std::array<Bernstein2, 3> normalPolynomials(const BezierPatch& patch);
-/// (r_uu . N)(r_vv . N) - (r_uv . N)^2 = K |N|^4, bidegree (6m - 4, 6n - 4).
+/// (r_uu . N)(r_vv . N) - (r_uv . N)^2 = K |N|^4, bidegree (6m - 4, 6n - 4); of a rational
+/// patch a positive multiple of it (see the contract), bidegree (10m - 4, 10n - 4).
 Bernstein2 gaussianCurvatureNumerator(const BezierPatch& patch);
-/// |r_u x r_v|^2, bidegree (4m - 2, 4n - 2).
+/// |r_u x r_v|^2, bidegree (4m - 2, 4n - 2) (rational: |N|^2 of normalPolynomials' N).
 Bernstein2 normalLengthSquared(const BezierPatch& patch);
+/// A rational (or polynomial) patch's homogeneous coordinates X = w r (x, y, z) and w in
+/// Bernstein form, bidegree (m, n): coefficients w_jk p_jk and w_jk.
+std::array<Bernstein2, 4> homogeneousPolynomials(const BezierPatch& patch);
 
 /// The normal's direction field with collapsed edges factored out: N = r_u x r_v =
 /// u^a (1 - u)^b v^c (1 - v)^d q, where a boundary row or column of the control net collapses

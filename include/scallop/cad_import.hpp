@@ -40,9 +40,10 @@
 //           of the material as the face says; a FORWARD face keeps the surface's.
 //         - rational: a face whose Bezier pieces are not all polynomial (some piece's weights
 //           differ by more than 1e-14 relative: every exact cylinder, cone, sphere, torus
-//           and revolution) is refused, with the range of its weights: scallop's core has no
-//           rational patches yet, and approximating silently is not allowed. A piece whose
-//           weights are all equal is polynomial and accepted.
+//           and revolution) is refused, with the range of its weights, unless
+//           CadImportOptions::acceptRational: then each piece is a rational patch, its poles
+//           and weights as they are (a REVERSED face's reversed alike). Approximating
+//           silently is not allowed. A piece whose weights are all equal is polynomial.
 //         - validity: each patch must satisfy surface.hpp's contract (degree <= 20, regular);
 //           a face with a patch that does not is refused with validateSurface's reason.
 // Output: the surface (at least one patch), and per patch the face it came from.
@@ -90,6 +91,10 @@ struct CadImportOptions {
   /// Skip faces that cannot be imported exactly (rational, trimmed, of an unsupported kind,
   /// not regular) instead of refusing the file; they are listed in CadImport::skipped.
   bool skipUnsupportedFaces = false;
+  /// Rational faces become rational Bezier patches (bezier.hpp: poles and weights, exactly)
+  /// instead of being refused: for `scallop orient`, whose Gauss map takes them. The other
+  /// computations take polynomial patches only (surface.hpp's requirePolynomial).
+  bool acceptRational = false;
 };
 
 /// Why a face was refused.

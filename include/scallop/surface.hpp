@@ -11,7 +11,10 @@
 //                 "control_points": [[[x, y, z], ... n + 1 points], ... m + 1 rows]}, ...]}
 // control_points[j][k] is the paper's p_jk, the coefficient of b_j^m(u) b_k^n(v) (eq 1):
 // row j runs along v. Both keys are required at each level and no other key is accepted (a
-// misspelt key is an error, not silently ignored). Coordinates are in the given units.
+// misspelt key is an error, not silently ignored), but for a patch's optional "weights":
+// [[w, ... n + 1], ... m + 1 rows], positive numbers shaped as the control points: a
+// rational patch (bezier.hpp's Rational patches; every exact cylinder, cone, sphere and
+// torus). Coordinates are in the given units.
 //
 // Contract
 // --------
@@ -30,6 +33,12 @@
 // the fans of cornerPieces, on which the corner is an apex row. Nets collapsed to a point or
 // a line, corners where q vanishes to higher order (no limit along some ray), and interior
 // points where q vanishes are rejected.
+// A rational patch's weights must be positive and finite, the largest at most
+// kMaxWeightRatio times the least; its regularity is decided as a polynomial patch's, on
+// N = w^3 r_u x r_v (bezier.hpp), its weights scaled by a power of two to a largest in
+// [0.5, 1). Rational patches are taken by the Gauss map and the optimal slicing (`scallop
+// orient`); the computations built on coordinate polynomials (sections, distances, tool
+// paths, the simulated cut) refuse them by name (requirePolynomial).
 // Degree 0 in a direction is rejected: r_u or r_v would vanish identically. (Accepted
 // patches also satisfy |r_u x r_v| > 1e-12 S_u S_v, above the threshold where bezier.hpp's
 // unitNormal throws, so unitNormal never throws on them.)
@@ -105,6 +114,9 @@ constexpr int kMaxPatchDegree = 20;
 constexpr double kMinPatchScale = 1e-20;
 constexpr double kMaxPatchScale = 1e20;
 
+/// A rational patch's largest weight over its least (bezier.hpp's Rational patches).
+constexpr double kMaxWeightRatio = 1e6;
+
 /// Quadtree limits of the regularity check (see the contract).
 constexpr int kRegularityMaxDepth = 16;
 constexpr std::size_t kRegularityMaxCells = 20000;
@@ -137,6 +149,10 @@ std::string surfaceToJson(const Surface& surface);
 
 /// Throws scallop::Error ("patches[i]...: ...") unless `surface` satisfies the contract.
 void validateSurface(const Surface& surface);
+
+/// scallop::Error naming `what` and the first rational patch, if any: for the computations
+/// that take polynomial patches only (sections, distances, tool paths, the simulated cut).
+void requirePolynomial(const Surface& surface, std::string_view what);
 /// The same, the message prefixed with `sourceName` ("s.json: patches[i]...: ...").
 void validateSurface(const Surface& surface, const std::string& sourceName);
 
