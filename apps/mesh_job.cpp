@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <memory>
 #include <numbers>
 #include <optional>
 #include <string>
@@ -85,11 +86,13 @@ MeshRasterResult runMeshRaster(const MeshJob& job, const MeshRasterRequest& requ
     }
     diagonal = norm(hi - lo);
   }
-  const Mesh solid = meshWithSkirt(mesh, 4e-6 * diagonal);
+  const auto solidMesh = std::make_shared<const Mesh>(meshWithSkirt(mesh, 4e-6 * diagonal));
+  const Mesh& solid = *solidMesh;
   // A tessellated part's proofs use the ball grown by the clearance: a centre R + c from the
   // mesh is at least R from every exact face within c of the mesh.
   const double proofRadius = radius + job.clearance;
-  const MeshDropCutter cutter(solid, proofRadius);
+  const auto cutterShared = std::make_shared<const MeshDropCutter>(solid, proofRadius);
+  const MeshDropCutter& cutter = *cutterShared;
   MeshRasterOptions raster;
   raster.spacing = spacing;
   // A chord of the drop line leaves at most its sag of material: a quarter of H, as the
@@ -164,6 +167,11 @@ MeshRasterResult runMeshRaster(const MeshJob& job, const MeshRasterRequest& requ
   report.tessellation = job.tessellation;
   result.top = top;
   result.simulation = simulation;
+  result.solid = solidMesh;
+  result.cutter = cutterShared;
+  result.dropLine.eps = paths.eps;
+  result.dropLine.sagTolerance = raster.sagTolerance;
+  result.dropLine.floor = raster.floor;
   result.report = std::move(report);
   result.paths = std::move(paths);
   return result;

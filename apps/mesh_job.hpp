@@ -5,6 +5,7 @@
 // the simulated cut and the files are the commands' own.
 
 #include <chrono>
+#include <memory>
 #include <cstddef>
 #include <optional>
 #include <string>
@@ -13,6 +14,7 @@
 #include "scallop/cad_tessellation.hpp"
 #include "scallop/cut_simulation.hpp"
 #include "scallop/mesh.hpp"
+#include "scallop/mesh_drop.hpp"
 #include "scallop/mesh_raster.hpp"
 #include "scallop/paths_output.hpp"
 
@@ -52,6 +54,11 @@ struct MeshRasterResult {
   SimulationOptions simulation;   // R, H (or the flat cusp of the spacing), allowance, stock top
   double top = 0.0;               // the mesh's highest vertex
   std::chrono::steady_clock::time_point start;
+  // What the raster was proven against, for more passes (rest finishing): the mesh walled
+  // down as a solid, its cutter (R plus the clearance) and the drop lines' options.
+  std::shared_ptr<const Mesh> solid;
+  std::shared_ptr<const MeshDropCutter> cutter;
+  DropLineOptions dropLine;
 };
 
 // The raster of `job` (refusals name request.source).

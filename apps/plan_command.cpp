@@ -115,7 +115,6 @@ void rejectMeshOptions(const PlanOptions& options, const char* what) {
   reject(options.noDropEnvelope, "--no-drop-envelope", "keeps a surface strategy's own centres (a mesh's passes are drop lines)");
   reject(options.constantSpacing, "--constant-spacing", "is the optimal planes' flat-surface spacing");
   reject(options.noLinking || options.oneWay, "--no-linking/--one-way", "order a surface plan's passes (a mesh's raster is one zigzag)");
-  reject(options.noRestFinishing, "--no-rest-finishing", "switches off what a mesh plan does not do yet");
 }
 
 // `plan` on an STL mesh: raster passes of exact drop lines (mesh_raster.hpp), every move proven
@@ -140,37 +139,44 @@ void runPlanMesh(const PlanOptions& options, MeshJob job) {
   const double spacing = raster.report.spacing;
   const double top = raster.top;
   SimulationOptions& simulation = raster.simulation;
-  const MeshRasterPaths& paths = raster.paths;
+  MeshRasterPaths& paths = raster.paths;
   PathsReport& report = raster.report;
   const auto start = raster.start;
   const double rapidRate = options.rapidRate.empty()
                                ? defaultRapidRate(mesh.units)
                                : parsePositive(options.rapidRate, "rapid rate", "a positive rate");
-  const GougeReport& gouge = *report.gouge;
 
   progress("writing the G-code");
   const GcodeDialect dialect = gcodeDialect(options.dialect);
   const std::string title = fmt::format("scallop plan raster {}", path);
   const std::string programName = dialect == GcodeDialect::grbl ? "toolpath.gcode" : "toolpath.ngc";
-  const GcodeOptions gcodeOptions = defaultGcodeOptions(mesh.units, top, paths.path, dialect, title);
-  const std::string program = gcodeProgram(paths.path, gcodeOptions);
-  report.motion = gcodeMotion(paths.path, gcodeOptions, rapidRate);
-  report.feedRate = gcodeOptions.feedRate;
-  report.plungeFeedRate = gcodeOptions.plungeFeedRate;
-  report.rapidRate = rapidRate;
-  const GcodeProgram written = parseGcodeProgram(program, programName);
-  const SimulationReport simulated = [&] {
+  // A tessellated part's exact design is computed once, for every simulation of the program.
+  std::optional<std::pair<HeightGrid, std::vector<double>>> exactDesign;
+  GcodeOptions gcodeOptions;
+  std::string program;
+  const auto writeAndSimulate = [&]() -> SimulationReport {
+    gcodeOptions = defaultGcodeOptions(mesh.units, top, paths.path, dialect, title);
+    program = gcodeProgram(paths.path, gcodeOptions);
+    const GcodeProgram written = parseGcodeProgram(program, programName);
     if (job.part) {
       HeightGrid grid = simulationGrid(mesh, simulation);
       if (grid.z.size() <= kExactDesignRays) {
-        progress(fmt::format("simulating the cut of the program on the part's exact faces ({} x {} vertical lines)",
-                             grid.columns, grid.rows));
+        if (!exactDesign) {
+          progress(fmt::format("the part's exact heights on {} x {} vertical lines", grid.columns, grid.rows));
+          HeightGrid heights = grid;
+          std::vector<double> normalZ;
+          job.part->designHeights(heights, &normalZ);
+          exactDesign.emplace(std::move(heights), std::move(normalZ));
+        }
+        progress("simulating the cut of the program on the part's exact faces");
         report.tessellation->exactDesign = true;
-        const CadPart& part = *job.part;
         return verifyProgram(
             mesh.units, std::move(grid), top,
-            [&part](HeightGrid& g, std::vector<double>& normalZ) { part.designHeights(g, &normalZ); }, written,
-            simulation, &mesh);
+            [&exactDesign](HeightGrid& g, std::vector<double>& normalZ) {
+              g.z = exactDesign->first.z;
+              normalZ = exactDesign->second;
+            },
+            written, simulation, &mesh);
       }
       progress(fmt::format("the simulation's {} x {} grid exceeds the budget of {} lines through the exact faces: "
                            "simulating the cut on the mesh",
@@ -179,7 +185,51 @@ void runPlanMesh(const PlanOptions& options, MeshJob job) {
       progress("simulating the cut of the program on the mesh (scallop verify)");
     }
     return verifyProgram(mesh, written, simulation);
-  }();
+  };
+  SimulationReport simulated = writeAndSimulate();
+  // Rest finishing (rest_finishing.hpp): where the simulated cut leaves more than H on points
+  // the ball can reach, passes through the balls that touch them, every step an exact drop
+  // line; the program is simulated again. Only when H was asked.
+  report.restFinishing = height.has_value() && !options.noRestFinishing;
+  for (int round = 0; report.restFinishing && round < kRestRounds; ++round) {
+    if (round > 0 ? simulated.uncutPoints == 0 : restTargets(simulated, *height).empty()) break;
+    RestOptions rest;
+    rest.toolRadius = report.toolRadius;
+    rest.scallopHeight = *height;
+    progress(fmt::format("rest finishing: {} grid points left above H", simulated.uncutPoints));
+    RestRound summary{simulated.maxScallop, simulated.uncutArea, {}};
+    RestPasses passes = meshRestPasses(*raster.solid, *raster.cutter, simulated, rest, raster.dropLine);
+    summary.rest = passes.report;
+    report.restRounds.push_back(summary);
+    if (passes.path.passes.empty()) break;
+    for (ToolPass& pass : passes.path.passes) paths.path.passes.push_back(std::move(pass));
+    simulated = writeAndSimulate();
+  }
+  if (!report.restRounds.empty()) {
+    // The deepest the ball comes, over the rest passes too (exact distances to the mesh).
+    GougeReport& deepest = *report.gouge;
+    double least = raster.cutter->radius() - deepest.signedMaxDepth;
+    for (std::size_t p = paths.path.passes.size(); p-- > 0;) {
+      const ToolPass& pass = paths.path.passes[p];
+      if (!pass.retractBefore) break;  // the rest passes are the trailing ones that retract
+      Vec3 at = pass.start;
+      for (const ToolMove& move : pass.moves) {
+        const double d = raster.cutter->segmentDistance(at, move.end, least);
+        if (d < least) {
+          least = d;
+          deepest.deepest.center = move.end;
+        }
+        at = move.end;
+      }
+    }
+    deepest.signedMaxDepth = raster.cutter->radius() - least;
+    deepest.maxDepth = std::max(0.0, deepest.signedMaxDepth);
+    deepest.depthBound = deepest.maxDepth;
+  }
+  report.motion = gcodeMotion(paths.path, gcodeOptions, rapidRate);
+  report.feedRate = gcodeOptions.feedRate;
+  report.plungeFeedRate = gcodeOptions.plungeFeedRate;
+  report.rapidRate = rapidRate;
   report.verification = verificationSummary(simulated, *simulation.stockAllowance);
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   progress("writing the report");
@@ -201,7 +251,8 @@ void runPlanMesh(const PlanOptions& options, MeshJob job) {
                  : std::string(),
              mesh.triangles.size(), paths.lines, paths.minSpacing, spacing, units, paths.centreLength, units,
              paths.path.passes.empty() ? 0 : paths.path.passes[0].moves.size(), paths.eps, paths.unprovenMoves,
-             gouge.maxDepth, units, cycleSummary(report, mesh.units), simulated.maxGouge, simulated.maxScallop,
+             report.gouge->maxDepth, units, cycleSummary(report, mesh.units) + restSummary(report, mesh.units),
+             simulated.maxGouge, simulated.maxScallop,
              simulated.scallopP99, units,
              height && simulated.maxScallop > *height
                  ? fmt::format(" (above H = {} on {:.4g} {}^2: the facets' cusps are modelled, not the edges between "

@@ -529,7 +529,7 @@ void designHeights(const Surface& surface, HeightGrid& grid, std::vector<double>
 
 namespace {
 
-constexpr std::uint32_t kNoTriangle = std::numeric_limits<std::uint32_t>::max();
+constexpr std::uint32_t kNoTriangle = kNoDesignTriangle;
 
 // designHeights on a mesh, with the winning triangle per point (kNoTriangle where none) when
 // `triangles` is given.
@@ -578,6 +578,13 @@ void meshDesign(const Mesh& mesh, HeightGrid& grid, std::vector<double>* normalZ
 
 void designHeights(const Mesh& mesh, HeightGrid& grid, std::vector<double>* normalZ) {
   meshDesign(mesh, grid, normalZ, nullptr);
+}
+
+std::vector<std::uint32_t> designTriangles(const Mesh& mesh, const HeightGrid& grid) {
+  HeightGrid copy = grid;
+  std::vector<std::uint32_t> triangles;
+  meshDesign(mesh, copy, nullptr, &triangles);
+  return triangles;
 }
 
 // The grid points within R (horizontally) of a move's box: the only ones it can lower.

@@ -87,6 +87,32 @@ class WitnessBuckets {
   std::unordered_map<std::uint64_t, std::vector<std::size_t>> buckets_;
 };
 
+// The witnesses chained nearest-next into passes (see the contract's Passes), unlifted.
+ToolPath chainWitnesses(const std::vector<Vec3>& witnesses, double gap, Units units, double radius) {
+  WitnessBuckets buckets(witnesses, gap);
+  std::vector<bool> visited(witnesses.size(), false);
+  ToolPath chains;
+  chains.units = units;
+  chains.toolRadius = radius;
+  for (std::size_t first = 0; first < witnesses.size(); ++first) {
+    if (visited[first]) continue;
+    visited[first] = true;
+    buckets.take(first);
+    ToolPass pass;
+    pass.start = witnesses[first];
+    pass.retractBefore = true;
+    Vec3 at = pass.start;
+    for (std::size_t next = buckets.takeNearest(at); next < witnesses.size(); next = buckets.takeNearest(at)) {
+      visited[next] = true;
+      at = witnesses[next];
+      pass.moves.push_back(ToolMove{MoveKind::line, at, {}, ArcPlane::xy, true});
+    }
+    if (pass.moves.empty()) pass.moves.push_back(ToolMove{MoveKind::line, at, {}, ArcPlane::xy, true});
+    chains.passes.push_back(std::move(pass));
+  }
+  return chains;
+}
+
 double scallopAt(const SimulationReport& simulated, std::size_t index) {
   const double design = simulated.design.z[index];
   if (design == -kInf) return 0.0;
@@ -178,27 +204,7 @@ RestPasses restPasses(const Surface& surface, const SimulationReport& simulated,
 
   // Chains, nearest next.
   const double gap = options.chainGap > 0.0 ? options.chainGap : std::min(8.0 * design.spacing, radius);
-  WitnessBuckets buckets(witnesses, gap);
-  std::vector<bool> visited(witnesses.size(), false);
-  ToolPath chains;
-  chains.units = surface.units;
-  chains.toolRadius = radius;
-  for (std::size_t first = 0; first < witnesses.size(); ++first) {
-    if (visited[first]) continue;
-    visited[first] = true;
-    buckets.take(first);
-    ToolPass pass;
-    pass.start = witnesses[first];
-    pass.retractBefore = true;
-    Vec3 at = pass.start;
-    for (std::size_t next = buckets.takeNearest(at); next < witnesses.size(); next = buckets.takeNearest(at)) {
-      visited[next] = true;
-      at = witnesses[next];
-      pass.moves.push_back(ToolMove{MoveKind::line, at, {}, ArcPlane::xy, true});
-    }
-    if (pass.moves.empty()) pass.moves.push_back(ToolMove{MoveKind::line, at, {}, ArcPlane::xy, true});
-    chains.passes.push_back(std::move(pass));
-  }
+  const ToolPath chains = chainWitnesses(witnesses, gap, surface.units, radius);
   report.passes = chains.passes.size();
 
   out.path = liftToDropEnvelope(distance, chains, lifting, report.envelope);
@@ -208,6 +214,84 @@ RestPasses restPasses(const Surface& surface, const SimulationReport& simulated,
       report.length += norm(move.end - at);
       at = move.end;
     }
+  }
+  return out;
+}
+
+RestPasses meshRestPasses(const Mesh& mesh, const MeshDropCutter& cutter, const SimulationReport& simulated,
+                          const RestOptions& options, const DropLineOptions& dropLine) {
+  validate(options);
+  const std::vector<std::size_t> targets =
+      restTargets(simulated, options.scallopHeight, options.threshold, options.neighbourhood);
+  const HeightGrid& design = simulated.design;
+  const double radius = cutter.radius();
+  const double height = options.scallopHeight;
+  RestPasses out;
+  out.path.units = mesh.units;
+  out.path.toolRadius = options.toolRadius;
+  RestReport& report = out.report;
+  for (const std::size_t index : targets)
+    report.maxScallopBefore = std::max(report.maxScallopBefore, scallopAt(simulated, index));
+  report.targets = targets.size();
+  if (targets.empty()) return out;
+  if (targets.size() > options.maxTargets) {
+    report.overBudget = true;
+    return out;
+  }
+  // Witnesses: the ball touching q from q + R' n, raised onto the exact drop envelope.
+  const std::vector<std::uint32_t> triangles = designTriangles(mesh, design);
+  std::vector<Vec3> witnesses;
+  for (const std::size_t index : targets) {
+    const std::uint32_t t = triangles[index];
+    if (t == kNoDesignTriangle) {
+      ++report.unreached;
+      continue;
+    }
+    const Vec2 p = design.point(index % design.columns, index / design.columns);
+    const Vec3 q{p.x, p.y, design.z[index]};
+    Vec3 n = triangleNormal(mesh, t);
+    if (n.z < 0.0) n = -n;
+    const Vec3 c = q + radius * n;
+    const double z = cutter.drop(c.x, c.y).z;
+    if (!std::isfinite(z)) {
+      ++report.unreached;
+      continue;
+    }
+    const double lift = std::max(0.0, z - c.z);
+    if (std::sqrt(radius * radius + 2.0 * radius * lift * n.z + lift * lift) - radius > height) {
+      ++report.unreached;
+      continue;
+    }
+    witnesses.push_back({c.x, c.y, c.z + lift});
+  }
+  report.witnesses = witnesses.size();
+  if (witnesses.empty()) return out;
+  const double gap = options.chainGap > 0.0 ? options.chainGap : std::min(8.0 * design.spacing, radius);
+  const ToolPath chains = chainWitnesses(witnesses, gap, mesh.units, options.toolRadius);
+  report.passes = chains.passes.size();
+  // Every step an exact drop line: the ball's centre on the proven envelope between witnesses.
+  for (const ToolPass& chain : chains.passes) {
+    ToolPass pass;
+    pass.retractBefore = true;
+    const DropLine first = cutter.dropLine({chain.start.x, chain.start.y}, {1.0, 0.0}, 0.0, 0.0, dropLine);
+    pass.start = first.vertices.front().centre;
+    Vec3 at = pass.start;
+    for (const ToolMove& move : chain.moves) {
+      const Vec2 from{at.x, at.y}, to{move.end.x, move.end.y};
+      const double length = norm(to - from);
+      if (length == 0.0) continue;
+      const DropLine line = cutter.dropLine(from, (1.0 / length) * (to - from), 0.0, length, dropLine);
+      report.envelope.proofs += line.proofs;
+      report.envelope.unprovenMoves += line.unprovenMoves;
+      for (std::size_t v = 1; v < line.vertices.size(); ++v) {
+        pass.moves.push_back(ToolMove{MoveKind::line, line.vertices[v].centre, {}, ArcPlane::xy, true});
+        report.length += norm(line.vertices[v].centre - at);
+        at = line.vertices[v].centre;
+      }
+    }
+    if (pass.moves.empty()) pass.moves.push_back(ToolMove{MoveKind::line, at, {}, ArcPlane::xy, true});
+    report.envelope.movesOut += pass.moves.size();
+    out.path.passes.push_back(std::move(pass));
   }
   return out;
 }

@@ -103,6 +103,7 @@
 //         over its budget (maxEvaluations, counted before sweeping).
 
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <limits>
 #include <optional>
@@ -251,6 +252,11 @@ using DesignHeightsFunction = std::function<void(HeightGrid& grid, std::vector<d
 /// The highest triangle of `mesh` over every point of `grid` (see the contract's Meshes);
 /// `normalZ`, if given, receives |n_z| of its unit normal (0 where there is none).
 void designHeights(const Mesh& mesh, HeightGrid& grid, std::vector<double>* normalZ = nullptr);
+
+/// Per point of `grid`, the triangle of `mesh` that designHeights takes there (the highest
+/// over it), or kNoDesignTriangle: rest finishing's normals on a mesh.
+inline constexpr std::uint32_t kNoDesignTriangle = 0xffffffffu;
+std::vector<std::uint32_t> designTriangles(const Mesh& mesh, const HeightGrid& grid);
 
 /// The visible height of `surface` at every point of `grid` (see the contract); `normalZ`,
 /// if given, receives |n_z| of the unit normal there (0 off the surface).

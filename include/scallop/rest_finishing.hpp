@@ -62,6 +62,8 @@
 
 #include "scallop/cut_simulation.hpp"
 #include "scallop/envelope.hpp"
+#include "scallop/mesh.hpp"
+#include "scallop/mesh_drop.hpp"
 #include "scallop/surface.hpp"
 #include "scallop/toolpath.hpp"
 
@@ -110,5 +112,17 @@ std::vector<std::size_t> restTargets(const SimulationReport& simulated, double s
 
 /// The rest passes of a simulated program (see the contract).
 RestPasses restPasses(const Surface& surface, const SimulationReport& simulated, const RestOptions& options);
+
+/// The same over a triangle mesh (an STL file, or a STEP/IGES part's tessellation), simulated
+/// on the grid of `simulated`: the same targets; each witness is c = q + R' n, n the upward
+/// unit normal of the triangle that holds q over its grid point (designTriangles), raised
+/// onto the exact drop envelope of `cutter` (radius R': R, or R plus a tessellation's
+/// clearance), with the gap test as above; the chains as above, each step from one witness to
+/// the next an exact drop line (MeshDropCutter::dropLine from the first's xy toward the
+/// next's, with `dropLine`'s eps, sag tolerance and floor), so every move is proven as the
+/// mesh raster's. options.depthTolerance and sagTolerance are unused (dropLine's instead);
+/// report.envelope counts the drop lines' moves, proofs and unproven moves.
+RestPasses meshRestPasses(const Mesh& mesh, const MeshDropCutter& cutter, const SimulationReport& simulated,
+                          const RestOptions& options, const DropLineOptions& dropLine);
 
 }  // namespace scallop
