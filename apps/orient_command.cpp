@@ -225,6 +225,7 @@ void runOrient(const OrientOptions& options) {
     throw Error(fmt::format("{}: --skip-faces orients the faces imported exactly, --tessellate all of them by the "
                             "mesh: give one",
                             options.surface.input));
+  if (!options.deflection.empty()) (void)parsePositive(options.deflection, "deflection", "a positive length");
   if (cad && !options.surface.skipFaces) {
     const CadPart part(options.surface.input);
     std::optional<CadImport> exact;

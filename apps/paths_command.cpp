@@ -135,6 +135,7 @@ void runPaths(const PathsOptions& options) {
     throw Error(fmt::format("{}: --skip-faces keeps only the faces imported exactly, --tessellate all of them "
                             "through the mesh: give one",
                             options.surface.input));
+  if (!options.deflection.empty()) (void)parsePositive(options.deflection, "deflection", "a positive length");
   if (cad && !options.surface.skipFaces) {
     const CadPart part(options.surface.input);
     std::optional<CadImport> exact;

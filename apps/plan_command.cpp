@@ -291,6 +291,8 @@ void runPlan(const PlanOptions& options) {
     throw Error(fmt::format("{}: --skip-faces plans only the faces imported exactly, --tessellate all of them "
                             "through the mesh: give one",
                             options.surface.input));
+  // A bad deflection is a usage error, before the file is read.
+  if (!options.deflection.empty()) (void)parsePositive(options.deflection, "deflection", "a positive length");
   if (cad && !options.surface.skipFaces) {
     // Every face exact: the surface route below. Otherwise (or asked) the tessellation.
     const CadPart part(options.surface.input);
