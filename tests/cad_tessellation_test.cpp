@@ -481,6 +481,11 @@ TEST_F(CadTessellationCli, PlanAndVerifyOpenCascadesSampleStepAndIgesParts) {
     const auto report = nlohmann::json::parse(scallop::test::readFile(workDir_ / "out" / "report.json"));
     EXPECT_EQ(report["tessellation"]["design"], "exact faces") << sample.file;
     EXPECT_LE(report["verification"]["max_gouge"].get<double>(), 0.0025) << sample.file;
+    if (sample.file == "iges/bearing.iges") {
+      // Its model's tolerance makes the clearance exceed H: no rest pass could help, none is made.
+      EXPECT_GE(report["tessellation"]["clearance"].get<double>(), 0.0008);
+      EXPECT_TRUE(report["rest_finishing"].is_null());
+    }
     if (sample.file == "step/screw.step") {
       // Its slot is narrower than the ball: beyond reach, not in the scallop figures, which the
       // passes (aimed at H less the tessellation's clearance and deviation) keep below H.
