@@ -217,25 +217,9 @@ void runOrient(const OrientOptions& options) {
   }
   if (!options.units.empty() || options.dropZeroArea)
     throw Error("--units and --drop-zero-area are for STL meshes (a .stl file); a surface's units are in its file");
-  const bool cad = !options.surface.input.empty() && options.surface.input != "-" &&
-                   cadFormatOf(options.surface.input).has_value();
-  if (!cad && (options.tessellate || !options.deflection.empty()))
-    throw Error("--tessellate and --deflection are for STEP and IGES parts (.step, .stp, .iges, .igs)");
-  if (cad && options.surface.skipFaces && options.tessellate)
-    throw Error(fmt::format("{}: --skip-faces orients the faces imported exactly, --tessellate all of them by the "
-                            "mesh: give one",
-                            options.surface.input));
-  if (!options.deflection.empty()) (void)parsePositive(options.deflection, "deflection", "a positive length");
-  if (cad && !options.surface.skipFaces) {
-    const CadPart part(options.surface.input);
-    std::optional<CadImport> exact;
-    if (!options.tessellate) exact = part.exactFaces(/*acceptRational=*/true);
-    if (options.tessellate || !exact->skipped.empty()) return runOrientTessellated(options, part, exact);
-  }
-  if (!options.deflection.empty())
-    throw Error(fmt::format("{}: --deflection is for a tessellated part (--tessellate, or faces that cannot be "
-                            "imported exactly); this one is oriented on its exact faces",
-                            sourceName(options.surface)));
+  // The Gauss map takes rational patches (bezier.hpp): only trimmed faces need the tessellation.
+  const CadRoute route = cadRoute(options.surface, options.tessellate, options.deflection, true);
+  if (route.tessellate) return runOrientTessellated(options, *route.part, route.exact);
   OptimalSlicingOptions slicingOptions;  // the library's default tolerance unless given
   double toleranceDeg = defaultToleranceDeg();
   if (!options.tolerance.empty()) {
@@ -247,7 +231,7 @@ void runOrient(const OrientOptions& options) {
 
   SurfaceSource source = options.surface;
   source.acceptRational = true;  // the Gauss map takes rational patches (bezier.hpp)
-  const Surface surface = loadSurface(source);
+  const Surface surface = loadSurface(source, true, route.exact ? &*route.exact : nullptr);
   const OptimalSlicing result = optimalSlicing(surface, slicingOptions);
 
   std::vector<OutputFile> outputs;

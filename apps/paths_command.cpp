@@ -55,6 +55,18 @@ struct PathsOptions {
   std::string deflection;     // --deflection D: that tessellation's
 };
 
+// What paths asks of a mesh raster (its progress lines off: paths prints one summary).
+MeshRasterRequest meshRequest(const PathsOptions& options) {
+  MeshRasterRequest request;
+  request.source = sourceName(options.surface);
+  request.command = "paths";
+  request.toolRadius = options.toolRadius;
+  request.scallopHeight = options.scallopHeight;
+  request.spacing = options.spacing;
+  request.quiet = true;
+  return request;
+}
+
 // `paths` on a triangle mesh (an STL file, or a STEP/IGES part's tessellation): the raster of
 // exact drop lines (mesh_job.hpp), every move proven, as JSON and G-code.
 void runPathsMesh(const PathsOptions& options, const MeshJob& job) {
@@ -73,14 +85,7 @@ void runPathsMesh(const PathsOptions& options, const MeshJob& job) {
   reject(options.noLinking || options.oneWay, "--no-linking/--one-way", "order a surface plan's passes (a mesh's raster is one zigzag)");
   reject(options.noGougeCheck, "--no-gouge-check", "skips a surface's sampled check (a mesh's moves are all proven exactly)");
   reject(!options.svgPath.empty(), "--svg", "draws a surface's sections (scallop plan draws a mesh's simulated cut)");
-  MeshRasterRequest request;
-  request.source = source;
-  request.command = "paths";
-  request.toolRadius = options.toolRadius;
-  request.scallopHeight = options.scallopHeight;
-  request.spacing = options.spacing;
-  request.quiet = true;
-  MeshRasterResult raster = runMeshRaster(job, request);
+  MeshRasterResult raster = runMeshRaster(job, meshRequest(options));
   const Units units = job.mesh.units;
   const double rapidRate = options.rapidRate.empty()
                                ? defaultRapidRate(units)
@@ -127,36 +132,14 @@ void runPaths(const PathsOptions& options) {
   }
   if (!options.units.empty() || options.dropZeroArea)
     throw Error("--units and --drop-zero-area are for STL meshes (a .stl file); a surface's units are in its file");
-  const bool cad = !options.surface.input.empty() && options.surface.input != "-" &&
-                   cadFormatOf(options.surface.input).has_value();
-  if (!cad && (options.tessellate || !options.deflection.empty()))
-    throw Error("--tessellate and --deflection are for STEP and IGES parts (.step, .stp, .iges, .igs)");
-  if (cad && options.surface.skipFaces && options.tessellate)
-    throw Error(fmt::format("{}: --skip-faces keeps only the faces imported exactly, --tessellate all of them "
-                            "through the mesh: give one",
-                            options.surface.input));
-  if (!options.deflection.empty()) (void)parsePositive(options.deflection, "deflection", "a positive length");
-  if (cad && !options.surface.skipFaces) {
-    const CadPart part(options.surface.input);
-    std::optional<CadImport> exact;
-    if (!options.tessellate) exact = part.exactFaces();
-    if (options.tessellate || !exact->skipped.empty()) {
-      MeshRasterRequest request;
-      request.source = sourceName(options.surface);
-      request.command = "paths";
-      request.toolRadius = options.toolRadius;
-      request.scallopHeight = options.scallopHeight;
-      request.spacing = options.spacing;
-      request.quiet = options.jsonPath.empty() && options.gcodePath.empty();  // JSON on stdout: stderr quiet too
-      MeshJob mesh = tessellatedJob(part, exact, request, options.deflection);
-      mesh.part = &part;
-      return runPathsMesh(options, mesh);
-    }
+  const CadRoute route = cadRoute(options.surface, options.tessellate, options.deflection, false);
+  if (route.tessellate) {
+    MeshRasterRequest request = meshRequest(options);
+    request.quiet = options.jsonPath.empty() && options.gcodePath.empty();  // JSON on stdout: stderr quiet too
+    MeshJob mesh = tessellatedJob(*route.part, route.exact, request, options.deflection);
+    mesh.part = &*route.part;
+    return runPathsMesh(options, mesh);
   }
-  if (!options.deflection.empty())
-    throw Error(fmt::format("{}: --deflection is for a tessellated part (--tessellate, or faces that cannot be "
-                            "machined exactly); this one is cut on its exact faces",
-                            sourceName(options.surface)));
   const std::string strategy = options.strategy.empty() ? "contour" : options.strategy;
   if (strategy == "contour" && !options.angle.empty())
     throw CLI::ValidationError("paths", "--angle is for --strategy raster");
@@ -175,7 +158,7 @@ void runPaths(const PathsOptions& options) {
   job.constantSpacing = options.constantSpacing;
   job.linking.direction = options.oneWay ? PassDirection::keep : PassDirection::zigzag;
 
-  const Surface surface = loadSurface(options.surface);
+  const Surface surface = loadSurface(options.surface, true, route.exact ? &*route.exact : nullptr);
   const std::string source = sourceName(options.surface);
   try {
     requirePolynomial(surface, "scallop paths");

@@ -117,6 +117,18 @@ void rejectMeshOptions(const PlanOptions& options, const char* what) {
   reject(options.noLinking || options.oneWay, "--no-linking/--one-way", "order a surface plan's passes (a mesh's raster is one zigzag)");
 }
 
+// What plan asks of a mesh raster.
+MeshRasterRequest meshRequest(const PlanOptions& options) {
+  MeshRasterRequest request;
+  request.source = sourceName(options.surface);
+  request.command = "plan";
+  request.toolRadius = options.toolRadius;
+  request.scallopHeight = options.scallopHeight;
+  request.spacing = options.spacing;
+  request.quiet = options.quiet;
+  return request;
+}
+
 // `plan` on an STL mesh: raster passes of exact drop lines (mesh_raster.hpp), every move proven
 // within eps; the program written and its cut simulated on the mesh itself.
 void runPlanMesh(const PlanOptions& options, MeshJob job) {
@@ -126,14 +138,7 @@ void runPlanMesh(const PlanOptions& options, MeshJob job) {
   auto progress = [&](const std::string& line) {
     if (!options.quiet) fmt::print(stderr, "scallop plan: {}...\n", line);
   };
-  MeshRasterRequest request;
-  request.source = path;
-  request.command = "plan";
-  request.toolRadius = options.toolRadius;
-  request.scallopHeight = options.scallopHeight;
-  request.spacing = options.spacing;
-  request.quiet = options.quiet;
-  MeshRasterResult raster = runMeshRaster(job, request);
+  MeshRasterResult raster = runMeshRaster(job, meshRequest(options));
   const Mesh& mesh = job.mesh;
   const std::optional<double> height = raster.report.scallopHeight;
   const double spacing = raster.report.spacing;
@@ -289,42 +294,17 @@ void runPlan(const PlanOptions& options) {
   }
   if (!options.units.empty() || options.dropZeroArea)
     throw Error("--units and --drop-zero-area are for STL meshes (a .stl file); a surface's units are in its file");
-  const bool cad = !options.surface.input.empty() && options.surface.input != "-" &&
-                   cadFormatOf(options.surface.input).has_value();
-  if (!cad && (options.tessellate || !options.deflection.empty()))
-    throw Error("--tessellate and --deflection are for STEP and IGES parts (.step, .stp, .iges, .igs)");
-  if (cad && options.surface.skipFaces && options.tessellate)
-    throw Error(fmt::format("{}: --skip-faces plans only the faces imported exactly, --tessellate all of them "
-                            "through the mesh: give one",
-                            options.surface.input));
-  // A bad deflection is a usage error, before the file is read.
-  if (!options.deflection.empty()) (void)parsePositive(options.deflection, "deflection", "a positive length");
-  if (cad && !options.surface.skipFaces) {
-    // Every face exact: the surface route below. Otherwise (or asked) the tessellation.
-    const CadPart part(options.surface.input);
-    std::optional<CadImport> exact;
-    if (!options.tessellate) exact = part.exactFaces();
-    if (options.tessellate || !exact->skipped.empty()) {
-      rejectMeshOptions(options, "a tessellated part");
-      MeshRasterRequest request;
-      request.source = sourceName(options.surface);
-      request.command = "plan";
-      request.toolRadius = options.toolRadius;
-      request.scallopHeight = options.scallopHeight;
-      request.spacing = options.spacing;
-      request.quiet = options.quiet;
-      MeshJob job = tessellatedJob(part, exact, request, options.deflection);
-      job.part = &part;
-      return runPlanMesh(options, std::move(job));
-    }
+  // Every face exact: the surface route below. Otherwise (or asked) the tessellation.
+  const CadRoute route = cadRoute(options.surface, options.tessellate, options.deflection, false);
+  if (route.tessellate) {
+    rejectMeshOptions(options, "a tessellated part");
+    MeshJob job = tessellatedJob(*route.part, route.exact, meshRequest(options), options.deflection);
+    job.part = &*route.part;
+    return runPlanMesh(options, std::move(job));
   }
-  if (!options.deflection.empty())
-    throw Error(fmt::format("{}: --deflection is for a tessellated part (--tessellate, or faces that cannot be "
-                            "machined exactly); this one is cut on its exact faces",
-                            sourceName(options.surface)));
   SurfaceSource from = options.surface;
   if (from.input.empty() && from.example.empty()) from.example = "paper-1";  // the main job
-  const Surface surface = loadSurface(from, !options.quiet);
+  const Surface surface = loadSurface(from, !options.quiet, route.exact ? &*route.exact : nullptr);
   const std::string source = sourceName(from);
   try {
     requirePolynomial(surface, "scallop plan");

@@ -12,6 +12,7 @@
 
 #include <fmt/format.h>
 
+#include "arguments.hpp"
 #include "scallop/cad_import.hpp"
 #include "scallop/error.hpp"
 #include "scallop/mesh.hpp"
@@ -48,11 +49,11 @@ std::string sourceBaseName(const SurfaceSource& source) {
 
 // A STEP or IGES file through scallop::cad, and the line that says what came of it: the
 // units especially, which the file chose and every length on the command line is in.
-Surface importCadSurface(const SurfaceSource& source, CadFormat format, bool announce) {
+Surface importCadSurface(const SurfaceSource& source, CadFormat format, bool announce, const CadImport* given) {
   CadImportOptions options;
   options.skipUnsupportedFaces = source.skipFaces;
   options.acceptRational = source.acceptRational;
-  CadImport imported = importCad(source.input, format, options);
+  CadImport imported = given ? *given : importCad(source.input, format, options);
   if (announce) {
     std::string skipped;
     if (!imported.skipped.empty()) {
@@ -100,7 +101,7 @@ void requireOneSurfaceSource(const SurfaceSource& source, const std::string& com
   }
 }
 
-Surface loadSurface(const SurfaceSource& source, bool announce) {
+Surface loadSurface(const SurfaceSource& source, bool announce, const CadImport* imported) {
   const std::optional<CadFormat> cad =
       source.example.empty() ? cadFormatOf(source.input) : std::optional<CadFormat>();
   if (source.skipFaces && !cad)
@@ -116,13 +117,13 @@ Surface loadSurface(const SurfaceSource& source, bool announce) {
                                                                   : parseBptSurface(standardInput(), "-", check);
   };
   if (source.patches.empty()) {
-    if (cad) return importCadSurface(source, *cad, announce);
+    if (cad) return importCadSurface(source, *cad, announce, imported);
     return source.example.empty() ? read(SurfaceCheck::full) : exampleSurface(source.example);
   }
   const std::string name = sourceBaseName(source);
   // Examples are built, not read: they are not validated (as without --patches). A CAD
   // import validates every patch it returns.
-  const Surface whole = cad ? importCadSurface(source, *cad, announce)
+  const Surface whole = cad ? importCadSurface(source, *cad, announce, imported)
                         : source.example.empty() ? read(SurfaceCheck::formOnly)
                                                  : exampleSurface(source.example);
   std::vector<std::size_t> indices;
@@ -134,6 +135,28 @@ Surface loadSurface(const SurfaceSource& source, bool announce) {
   Surface selected = selectPatches(whole, indices);
   if (source.example.empty() && !cad) validateSelection(selected, indices, name);
   return selected;
+}
+
+CadRoute cadRoute(const SurfaceSource& source, bool tessellate, const std::string& deflection, bool acceptRational) {
+  const bool cad = !source.input.empty() && source.input != "-" && cadFormatOf(source.input).has_value();
+  if (!cad && (tessellate || !deflection.empty()))
+    throw Error("--tessellate and --deflection are for STEP and IGES parts (.step, .stp, .iges, .igs)");
+  if (cad && source.skipFaces && tessellate)
+    throw Error(fmt::format("{}: --skip-faces takes only the faces imported exactly, --tessellate all of them "
+                            "through the mesh: give one",
+                            source.input));
+  if (!deflection.empty()) (void)parsePositive(deflection, "deflection", "a positive length");
+  CadRoute route;
+  if (cad && !source.skipFaces) {
+    route.part.emplace(source.input);
+    if (!tessellate) route.exact = route.part->exactFaces(acceptRational);
+    route.tessellate = tessellate || !route.exact->skipped.empty();
+  }
+  if (!route.tessellate && !deflection.empty())
+    throw Error(fmt::format("{}: --deflection is for a tessellated part (--tessellate, or faces that cannot be "
+                            "imported exactly); this one is taken on its exact faces",
+                            sourceName(source)));
+  return route;
 }
 
 std::string sourceName(const SurfaceSource& source) {

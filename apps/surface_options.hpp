@@ -4,10 +4,13 @@
 // patches) and,
 // for the tool-path commands, the strategy and the G-code dialect.
 
+#include <optional>
 #include <string>
 
 #include <CLI/CLI.hpp>
 
+#include "scallop/cad_import.hpp"
+#include "scallop/cad_tessellation.hpp"
 #include "scallop/gcode.hpp"
 #include "scallop/mesh.hpp"
 #include "scallop/surface.hpp"
@@ -44,8 +47,24 @@ void addSkipFacesOption(CLI::App& command, SurfaceSource& source);
 /// validates every patch and names the face at fault; when `announce`, a line on stderr then
 /// says what was read: format, faces, patches, units, faces skipped. Any other file is JSON or
 /// .bpt; with a selection it is validated after the selection, so the patches not kept need
-/// not be regular; errors name the patches by their indices in the file.
-Surface loadSurface(const SurfaceSource& source, bool announce = true);
+/// not be regular; errors name the patches by their indices in the file. `imported`: a STEP or
+/// IGES file's faces already converted (CadRoute::exact), used instead of reading it again.
+Surface loadSurface(const SurfaceSource& source, bool announce = true, const CadImport* imported = nullptr);
+
+/// How a command takes a STEP or IGES part: on its exact faces (the surface route), or through
+/// its tessellation (cad_tessellation.hpp) when some face cannot be imported exactly or
+/// --tessellate is given. The part is read once.
+struct CadRoute {
+  std::optional<CadPart> part;     ///< read when the input is STEP or IGES and --skip-faces is not given
+  std::optional<CadImport> exact;  ///< its faces converted exactly (without --tessellate)
+  bool tessellate = false;         ///< take the part through its tessellation
+};
+
+/// The route for `source`. Refused in one line, before the file is read: --tessellate or
+/// --deflection for anything but STEP or IGES, --tessellate with --skip-faces, a deflection
+/// that is not a positive length; after it, --deflection on the exact route.
+/// `acceptRational`: rational faces are exact (orient's Gauss map takes them).
+CadRoute cadRoute(const SurfaceSource& source, bool tessellate, const std::string& deflection, bool acceptRational);
 
 /// How messages and reports name the surface: "example NAME", "<stdin>" or the path, followed
 /// by " (patches LIST)" when some are selected.

@@ -75,27 +75,27 @@ int runVerify(const VerifyOptions& options) {
   // A STEP or IGES part with faces the exact importer refuses (trimmed, rational) is judged
   // on its exact faces through OCCT (cad_tessellation.hpp), unless --skip-faces asks for the
   // exact faces alone.
-  std::optional<CadPart> part;
+  std::optional<CadRoute> route;
+  const CadPart* part = nullptr;
   if (mesh) {
     stl = loadStlMesh(source.input, options.units, options.dropZeroArea);
-  } else if (expected == 2 && source.input != "-" && !options.skipFaces && cadFormatOf(source.input)) {
-    part.emplace(source.input);
-    if (!options.patches.empty())
-      throw Error(fmt::format("{}: --patches selects Bezier patches; give --skip-faces to judge only the faces "
-                              "imported exactly",
-                              source.input));
-    const CadImport exact = part->exactFaces();
-    if (exact.skipped.empty()) {
-      part.reset();
-      surface = loadSurface(source);
-    } else if (options.jsonPath != kStandardStream) {
-      fmt::print(stderr,
-                 "scallop: {}: {} of {} faces cannot be imported as exact Bezier patches yet (the first: {}): the "
-                 "program is judged on the exact faces through OpenCASCADE (vertical lines through each grid point)\n",
-                 source.input, exact.skipped.size(), part->faces(), exact.skipped.front().reason);
-    }
   } else {
-    surface = loadSurface(source);
+    route = cadRoute(source, false, "", false);
+    if (route->tessellate) {
+      part = &*route->part;
+      if (!options.patches.empty())
+        throw Error(fmt::format("{}: --patches selects Bezier patches; give --skip-faces to judge only the faces "
+                                "imported exactly",
+                                source.input));
+      if (options.jsonPath != kStandardStream)
+        fmt::print(stderr,
+                   "scallop: {}: {} of {} faces cannot be imported as exact Bezier patches yet (the first: {}): the "
+                   "program is judged on the exact faces through OpenCASCADE (vertical lines through each grid "
+                   "point)\n",
+                   source.input, route->exact->skipped.size(), part->faces(), route->exact->skipped.front().reason);
+    } else {
+      surface = loadSurface(source, true, route->exact ? &*route->exact : nullptr);
+    }
   }
   if (surface) {
     try {

@@ -661,7 +661,7 @@ ReachPreparation meshReach(const Mesh& mesh, const HeightGrid& grid,
         const double z = cutter->drop(c.x, c.y).z;
         if (!std::isfinite(z)) return false;
         const double lift = std::max(0.0, z - c.z);
-        return std::sqrt(radius * radius + 2.0 * radius * lift * n.z + lift * lift) - radius > height;
+        return reachGap(radius, lift, n.z) > height;
       };
     };
   };
@@ -881,8 +881,12 @@ ReachWitness reachWitness(const SurfaceDistance& distance, DropCutter& cutter, V
   const double lift = std::max(0.0, z - c.z);
   out.centre = Vec3{c.x, c.y, c.z + lift};
   // |c + lift z - q| - R: how near to q the ball comes from where it would touch it.
-  out.gap = std::sqrt(radius * radius + 2.0 * radius * lift * n.z + lift * lift) - radius;
+  out.gap = reachGap(radius, lift, n.z);
   return out;
+}
+
+double reachGap(double radius, double lift, double normalZ) {
+  return std::sqrt(radius * radius + 2.0 * radius * lift * normalZ + lift * lift) - radius;
 }
 
 namespace {

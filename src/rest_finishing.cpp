@@ -158,26 +158,38 @@ std::vector<std::size_t> restTargets(const SimulationReport& simulated, double s
   return targets;
 }
 
-RestPasses restPasses(const Surface& surface, const SimulationReport& simulated, const RestOptions& options) {
+namespace {
+
+// The targets of `simulated` (validated options), with the report's first figures in `out`:
+// the path's units and radius, the targets, the largest scallop among them, the budget. Empty
+// when there is nothing to do: no target, or more than the budget.
+std::vector<std::size_t> startRest(const SimulationReport& simulated, const RestOptions& options, Units units,
+                                   RestPasses& out) {
   validate(options);
-  const std::vector<std::size_t> targets =
+  std::vector<std::size_t> targets =
       restTargets(simulated, options.scallopHeight, options.threshold, options.neighbourhood);
+  out.path.units = units;
+  out.path.toolRadius = options.toolRadius;
+  for (const std::size_t index : targets)
+    out.report.maxScallopBefore = std::max(out.report.maxScallopBefore, scallopAt(simulated, index));
+  out.report.targets = targets.size();
+  if (targets.size() > options.maxTargets) {
+    out.report.overBudget = true;
+    targets.clear();
+  }
+  return targets;
+}
+
+}  // namespace
+
+RestPasses restPasses(const Surface& surface, const SimulationReport& simulated, const RestOptions& options) {
+  RestPasses out;
+  const std::vector<std::size_t> targets = startRest(simulated, options, surface.units, out);
+  if (targets.empty()) return out;
   const HeightGrid& design = simulated.design;
   const double radius = options.toolRadius;
   const double height = options.scallopHeight;
-
-  RestPasses out;
-  out.path.units = surface.units;
-  out.path.toolRadius = radius;
   RestReport& report = out.report;
-  for (const std::size_t index : targets)
-    report.maxScallopBefore = std::max(report.maxScallopBefore, scallopAt(simulated, index));
-  report.targets = targets.size();
-  if (targets.empty()) return out;
-  if (targets.size() > options.maxTargets) {
-    report.overBudget = true;
-    return out;
-  }
 
   // Their witnesses: the ball touching q, dropped onto the envelope.
   const SurfaceDistance distance(surface);
@@ -220,24 +232,13 @@ RestPasses restPasses(const Surface& surface, const SimulationReport& simulated,
 
 RestPasses meshRestPasses(const Mesh& mesh, const MeshDropCutter& cutter, const SimulationReport& simulated,
                           const RestOptions& options, const DropLineOptions& dropLine) {
-  validate(options);
-  const std::vector<std::size_t> targets =
-      restTargets(simulated, options.scallopHeight, options.threshold, options.neighbourhood);
+  RestPasses out;
+  const std::vector<std::size_t> targets = startRest(simulated, options, mesh.units, out);
+  if (targets.empty()) return out;
   const HeightGrid& design = simulated.design;
   const double radius = cutter.radius();
   const double height = options.scallopHeight;
-  RestPasses out;
-  out.path.units = mesh.units;
-  out.path.toolRadius = options.toolRadius;
   RestReport& report = out.report;
-  for (const std::size_t index : targets)
-    report.maxScallopBefore = std::max(report.maxScallopBefore, scallopAt(simulated, index));
-  report.targets = targets.size();
-  if (targets.empty()) return out;
-  if (targets.size() > options.maxTargets) {
-    report.overBudget = true;
-    return out;
-  }
   // Witnesses: the ball touching q from q + R' n, raised onto the exact drop envelope.
   const std::vector<std::uint32_t> triangles = designTriangles(mesh, design);
   std::vector<Vec3> witnesses;
@@ -258,7 +259,7 @@ RestPasses meshRestPasses(const Mesh& mesh, const MeshDropCutter& cutter, const 
       continue;
     }
     const double lift = std::max(0.0, z - c.z);
-    if (std::sqrt(radius * radius + 2.0 * radius * lift * n.z + lift * lift) - radius > height) {
+    if (reachGap(radius, lift, n.z) > height) {
       ++report.unreached;
       continue;
     }

@@ -34,6 +34,11 @@ namespace scallop::test {
 namespace fs = std::filesystem;
 
 // OCCT's writers print statistics on standard output: not in the test log.
+// One of examples/surfaces/ (the paper's surfaces, the teapot), as the tests' originals.
+inline Surface exampleFile(const std::string& name) {
+  return readSurface(std::string(SCALLOP_EXAMPLES_DIR) + "/surfaces/" + name + ".json");
+}
+
 inline void quietOcct() { Message::DefaultMessenger()->ChangePrinters().Clear(); }
 
 inline Handle(Geom_BSplineSurface) bsplineOf(const BezierPatch& patch, double scale = 1.0) {

@@ -72,9 +72,8 @@ using scallop::test::writeIges;
 using scallop::test::writeStep;
 using CadImportTest = scallop::test::CadTempDir;
 
-const std::string kExamples = SCALLOP_EXAMPLES_DIR;
 
-Surface exampleFile(const std::string& name) { return scallop::readSurface(kExamples + "/surfaces/" + name + ".json"); }
+using scallop::test::exampleFile;
 
 // The largest distance between the patches at an n x n grid (both in [0, 1]^2), relative to
 // the size of `a`.

@@ -69,7 +69,7 @@ void expectErrorMentions(Call call, const std::vector<std::string>& parts) {
 const std::string kExamples = SCALLOP_EXAMPLES_DIR;
 const std::string kOcctSamples = "/usr/share/opencascade/data";
 
-Surface exampleFile(const std::string& name) { return scallop::readSurface(kExamples + "/surfaces/" + name + ".json"); }
+using scallop::test::exampleFile;
 
 // A 20 x 20 x 10 mm block with a cylindrical pocket of radius 4 around (10, 10) down to z = 6:
 // its top face is trimmed by the pocket's rim and the pocket's wall is a cylinder (rational).

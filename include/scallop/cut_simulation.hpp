@@ -281,6 +281,10 @@ struct ReachWitness {
 };
 ReachWitness reachWitness(const SurfaceDistance& distance, DropCutter& cutter, Vec3 q, double radius);
 
+/// The gap above: how far a ball of radius R lifted by L >= 0 from q + R n stays from q,
+/// sqrt(R^2 + 2 R L n_z + L^2) - R.
+double reachGap(double radius, double lift, double normalZ);
+
 /// The whole simulation: grid, design, sweep, comparison.
 SimulationReport simulateCut(const Surface& surface, const std::vector<SweptMove>& moves,
                              const SimulationOptions& options);
