@@ -200,6 +200,7 @@ void runPlanMesh(const PlanOptions& options, MeshJob job) {
   // clearance's, which no rest pass removes (bearing.iges: 298 passes for nothing).
   report.restFinishing =
       height.has_value() && !options.noRestFinishing && job.clearance + job.deviation < 0.5 * *height;
+  const std::size_t rasterPasses = paths.path.passes.size();
   for (int round = 0; report.restFinishing && round < kRestRounds; ++round) {
     if (round > 0 ? simulated.uncutPoints == 0 : restTargets(simulated, *height).empty()) break;
     // A second round only when the first took at least a tenth of what was above H.
@@ -217,12 +218,12 @@ void runPlanMesh(const PlanOptions& options, MeshJob job) {
     simulated = writeAndSimulate();
   }
   if (!report.restRounds.empty()) {
-    // The deepest the ball comes, over the rest passes too (exact distances to the mesh).
+    // The deepest the ball comes, over the rest passes too (exact distances to the mesh; the
+    // raster's own least distance is already in the report).
     GougeReport& deepest = *report.gouge;
     double least = raster.cutter->radius() - deepest.signedMaxDepth;
-    for (std::size_t p = paths.path.passes.size(); p-- > 0;) {
+    for (std::size_t p = rasterPasses; p < paths.path.passes.size(); ++p) {
       const ToolPass& pass = paths.path.passes[p];
-      if (!pass.retractBefore) break;  // the rest passes are the trailing ones that retract
       Vec3 at = pass.start;
       for (const ToolMove& move : pass.moves) {
         const double d = raster.cutter->segmentDistance(at, move.end, least);
