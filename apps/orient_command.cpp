@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <memory>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <system_error>
 #include <vector>
@@ -56,7 +57,11 @@ struct OrientOptions {
   bool dropZeroArea = false;  // --drop-zero-area: an STL mesh's zero-area triangles
   bool tessellate = false;    // --tessellate: a STEP/IGES part oriented by its tessellation
   std::string deflection;     // --deflection D: that tessellation's
+  std::string trimSpread;     // --trim-spread DEG: how closely pieces follow trimming curves
 };
+
+// The default of --trim-spread, degrees.
+constexpr double kDefaultTrimSpreadDeg = 2.0;
 
 // Where the JSON goes: --json, or standard output when no output is named at all.
 std::string jsonDestination(const OrientOptions& options) {
@@ -209,6 +214,35 @@ void printSummary(const std::string& source, const OptimalSlicing& result, bool 
              result.gaussMap.boundarySegments, result.seconds, written);
 }
 
+// A part with trimmed faces: alpha* between the certified lower bound (all pieces) and the
+// optimum of the inside pieces (see orient_output.hpp's trimmedOrientationToJson).
+void printTrimmedSummary(const std::string& source, const OptimalSlicing& result, const TrimmedFacts& facts,
+                         bool certify, const std::vector<OutputFile>& outputs) {
+  std::string written;
+  for (const OutputFile& output : outputs) written += (written.empty() ? "" : ", ") + output.path;
+  const std::string lower =
+      result.method == "covered"
+          ? std::string("alpha* >= 0 (the pieces' normals, boundary pieces included, cover the sphere)")
+      : certify && result.certified
+          ? fmt::format("alpha* >= {:.4f} deg (certified over the faces and their boundary pieces)",
+                        toDegrees(result.certifiedAlphaRad))
+          : fmt::format("alpha* >= {:.4f} deg ({})", toDegrees(result.alphaRad), certificateSummary(result, certify));
+  std::string upper = "no upper bound (no piece lies wholly inside a face)";
+  if (facts.inside != nullptr) {
+    upper = facts.inside->method == "covered"
+                ? std::string("alpha* = 0: the normals inside the faces alone cover the sphere (proven): no slicing "
+                              "direction exists")
+                : fmt::format("<= {:.4f} deg (the optimum of the pieces inside the faces)",
+                              toDegrees(facts.inside->alphaRad));
+  }
+  fmt::print(stderr,
+             "scallop: {}: {} trimmed faces followed by {} pieces inside and {} on their trimming curves (normals "
+             "within {:.4g} deg): N* = ({:.6f}, {:.6f}, {:.6f}), {}, {}; {:.3f} s -> {}\n",
+             source, facts.faces, facts.insidePieces, facts.boundaryPieces, toDegrees(facts.largestSpreadRad),
+             result.normal.x, result.normal.y, result.normal.z, lower, upper,
+             result.seconds + (facts.inside != nullptr ? facts.inside->seconds : 0.0), written);
+}
+
 void runOrient(const OrientOptions& options) {
   checkOptions(options);
   if (isStlSource(options.surface.input)) {
@@ -217,8 +251,22 @@ void runOrient(const OrientOptions& options) {
   }
   if (!options.units.empty() || options.dropZeroArea)
     throw Error("--units and --drop-zero-area are for STL meshes (a .stl file); a surface's units are in its file");
-  // The Gauss map takes rational patches (bezier.hpp): only trimmed faces need the tessellation.
-  const CadRoute route = cadRoute(options.surface, options.tessellate, options.deflection, true);
+  // The Gauss map takes rational patches (bezier.hpp), and trimmed faces as pieces that follow
+  // their trimming curves (trimmed_patch.hpp): only faces of other kinds need the tessellation.
+  CadImportOptions exactOptions;
+  exactOptions.acceptRational = true;
+  exactOptions.acceptTrimmed = true;
+  double trimSpreadDeg = kDefaultTrimSpreadDeg;
+  if (!options.trimSpread.empty()) {
+    trimSpreadDeg = parsePositive(options.trimSpread, "trim spread", "a positive angle in degrees, below 10");
+    if (!(trimSpreadDeg < 10.0))
+      throw Error(fmt::format("invalid trim spread '{}': must be below 10 degrees", options.trimSpread));
+  }
+  exactOptions.trimSplit.normalSpreadRad = trimSpreadDeg * (std::numbers::pi / 180.0);
+  const CadRoute route = cadRoute(options.surface, options.tessellate, options.deflection, exactOptions);
+  if (!options.trimSpread.empty() && !(route.exact && route.exact->trimmedFaces > 0))
+    throw Error(fmt::format("{}: --trim-spread is for STEP and IGES parts with trimmed faces, taken exactly",
+                            sourceName(options.surface)));
   if (route.tessellate) return runOrientTessellated(options, *route.part, route.exact);
   OptimalSlicingOptions slicingOptions;  // the library's default tolerance unless given
   double toleranceDeg = defaultToleranceDeg();
@@ -231,12 +279,39 @@ void runOrient(const OrientOptions& options) {
 
   SurfaceSource source = options.surface;
   source.acceptRational = true;  // the Gauss map takes rational patches (bezier.hpp)
+  const bool trimmed = route.exact && route.exact->trimmedFaces > 0;
+  if (trimmed && !options.surface.patches.empty())
+    throw Error(fmt::format("{}: --patches selects patches, and its trimmed faces are pieces: not with --patches",
+                            options.surface.input));
   const Surface surface = loadSurface(source, true, route.exact ? &*route.exact : nullptr);
   const OptimalSlicing result = optimalSlicing(surface, slicingOptions);
+  // A trimmed part: the pieces inside their faces alone bound alpha* from above (their normals
+  // are the part's), as the slicing of all of them bounds it from below.
+  std::optional<OptimalSlicing> inside;
+  TrimmedFacts facts;
+  if (trimmed) {
+    const CadImport& part = *route.exact;
+    Surface insidePieces{surface.units, {}};
+    for (std::size_t p = 0; p < surface.patches.size(); ++p)
+      if (part.patchRoles[p] == PieceRole::inside) insidePieces.patches.push_back(surface.patches[p]);
+    facts.faces = part.trimmedFaces;
+    facts.insidePieces = insidePieces.patches.size();
+    facts.boundaryPieces = surface.patches.size() - insidePieces.patches.size();
+    facts.spreadRad = exactOptions.trimSplit.normalSpreadRad;
+    facts.largestSpreadRad = part.largestSpreadRad;
+    if (!insidePieces.patches.empty()) {
+      OptimalSlicingOptions upperOptions = slicingOptions;
+      upperOptions.certify = false;  // it bounds alpha* from above: a lower bound of its own says nothing
+      inside = optimalSlicing(insidePieces, upperOptions);
+      facts.inside = &*inside;
+    }
+  }
 
   std::vector<OutputFile> outputs;
   const std::string jsonPath = jsonDestination(options);
-  if (!jsonPath.empty()) outputs.push_back({jsonPath, orientationToJson(result, toleranceDeg)});
+  if (!jsonPath.empty())
+    outputs.push_back({jsonPath, trimmed ? trimmedOrientationToJson(result, toleranceDeg, facts)
+                                         : orientationToJson(result, toleranceDeg)});
   if (!options.svgDir.empty()) {
     const fs::path dir = options.svgDir;
     outputs.push_back({(dir / kSphereFigure).string(), gaussMapSphereSvg(result)});
@@ -246,7 +321,11 @@ void runOrient(const OrientOptions& options) {
 
   // The summary goes to stderr, but stays quiet when the JSON is piped on standard output.
   if (jsonPath != kStandardStream) {
-    printSummary(sourceName(options.surface), result, slicingOptions.certify, outputs);
+    if (trimmed) {
+      printTrimmedSummary(sourceName(options.surface), result, facts, slicingOptions.certify, outputs);
+    } else {
+      printSummary(sourceName(options.surface), result, slicingOptions.certify, outputs);
+    }
   }
 }
 
@@ -277,8 +356,9 @@ void addOrientCommand(CLI::App& app) {
       "with a proof that the normals cover the sphere; otherwise the best direction found, "
       "certified.\n"
       "A STEP (.step, .stp) or IGES (.iges, .igs) file is read through OpenCASCADE: every face "
-      "becomes Bezier patches exactly, in the file's units (inches or millimetres); rational and "
-      "trimmed faces are refused (--skip-faces leaves them out).\n"
+      "becomes Bezier patches exactly, in the file's units (inches or millimetres); rational faces "
+      "as rational patches; trimmed faces become pieces that follow their trimming curves: alpha* is then given between a certified "
+      "lower bound (all pieces) and the optimum of the pieces inside the faces.\n"
       "A .stl file (binary or ASCII) is a triangle mesh: N* is then the centre of the largest "
       "spherical cap free of its +-facet normals (their convex hull's facet nearest the origin), "
       "alpha* the least angle to them; JSON only.\n"
@@ -313,6 +393,12 @@ void addOrientCommand(CLI::App& app) {
   orient->add_flag("--tessellate", options->tessellate,
                    "STEP/IGES: orient the part by its tessellation's facets (not certified) even when every face "
                    "could be imported exactly; parts with trimmed or rational faces are oriented so without it");
+  orient->add_option("--trim-spread", options->trimSpread,
+                     fmt::format("STEP/IGES trimmed faces: split the pieces crossing a trimming curve until their "
+                                 "normals spread by at most DEG degrees (default {}); alpha* is then bounded within "
+                                 "about that",
+                                 kDefaultTrimSpreadDeg))
+      ->type_name("DEG");
   orient->add_option("--deflection", options->deflection,
                      "STEP/IGES tessellation: OCCT mesher's linear deflection (default 1e-3 of the part's size)")
       ->type_name("D");

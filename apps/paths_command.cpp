@@ -132,7 +132,7 @@ void runPaths(const PathsOptions& options) {
   }
   if (!options.units.empty() || options.dropZeroArea)
     throw Error("--units and --drop-zero-area are for STL meshes (a .stl file); a surface's units are in its file");
-  const CadRoute route = cadRoute(options.surface, options.tessellate, options.deflection, false);
+  const CadRoute route = cadRoute(options.surface, options.tessellate, options.deflection);
   if (route.tessellate) {
     MeshRasterRequest request = meshRequest(options);
     request.quiet = options.jsonPath.empty() && options.gcodePath.empty();  // JSON on stdout: stderr quiet too

@@ -296,7 +296,7 @@ void runPlan(const PlanOptions& options) {
   if (!options.units.empty() || options.dropZeroArea)
     throw Error("--units and --drop-zero-area are for STL meshes (a .stl file); a surface's units are in its file");
   // Every face exact: the surface route below. Otherwise (or asked) the tessellation.
-  const CadRoute route = cadRoute(options.surface, options.tessellate, options.deflection, false);
+  const CadRoute route = cadRoute(options.surface, options.tessellate, options.deflection);
   if (route.tessellate) {
     rejectMeshOptions(options, "a tessellated part");
     MeshJob job = tessellatedJob(*route.part, route.exact, meshRequest(options), options.deflection);

@@ -137,7 +137,8 @@ Surface loadSurface(const SurfaceSource& source, bool announce, const CadImport*
   return selected;
 }
 
-CadRoute cadRoute(const SurfaceSource& source, bool tessellate, const std::string& deflection, bool acceptRational) {
+CadRoute cadRoute(const SurfaceSource& source, bool tessellate, const std::string& deflection,
+                  const CadImportOptions& exactOptions) {
   const bool cad = !source.input.empty() && source.input != "-" && cadFormatOf(source.input).has_value();
   if (!cad && (tessellate || !deflection.empty()))
     throw Error("--tessellate and --deflection are for STEP and IGES parts (.step, .stp, .iges, .igs)");
@@ -149,7 +150,7 @@ CadRoute cadRoute(const SurfaceSource& source, bool tessellate, const std::strin
   CadRoute route;
   if (cad && !source.skipFaces) {
     route.part.emplace(source.input);
-    if (!tessellate) route.exact = route.part->exactFaces(acceptRational);
+    if (!tessellate) route.exact = route.part->exactFaces(exactOptions);
     route.tessellate = tessellate || !route.exact->skipped.empty();
   }
   if (!route.tessellate && !deflection.empty())

@@ -63,8 +63,10 @@ struct CadRoute {
 /// The route for `source`. Refused in one line, before the file is read: --tessellate or
 /// --deflection for anything but STEP or IGES, --tessellate with --skip-faces, a deflection
 /// that is not a positive length; after it, --deflection on the exact route.
-/// `acceptRational`: rational faces are exact (orient's Gauss map takes them).
-CadRoute cadRoute(const SurfaceSource& source, bool tessellate, const std::string& deflection, bool acceptRational);
+/// `exactOptions`: what the exact route takes (orient's Gauss map takes rational faces and
+/// trimmed faces' pieces; the others neither).
+CadRoute cadRoute(const SurfaceSource& source, bool tessellate, const std::string& deflection,
+                  const CadImportOptions& exactOptions = {});
 
 /// How messages and reports name the surface: "example NAME", "<stdin>" or the path, followed
 /// by " (patches LIST)" when some are selected.

@@ -80,7 +80,7 @@ int runVerify(const VerifyOptions& options) {
   if (mesh) {
     stl = loadStlMesh(source.input, options.units, options.dropZeroArea);
   } else {
-    route = cadRoute(source, false, "", false);
+    route = cadRoute(source, false, "");
     if (route->tessellate) {
       part = &*route->part;
       if (!options.patches.empty())

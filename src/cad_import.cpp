@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
 #include <mutex>
 #include <string>
 #include <utility>
@@ -17,13 +18,18 @@
 
 #include <fmt/format.h>
 
+#include <BRepClass_FaceClassifier.hxx>
 #include <BRepTools.hxx>
 #include <BRep_Tool.hxx>
+#include <ElSLib.hxx>
 #include <GeomAPI_ProjectPointOnSurf.hxx>
 #include <GeomAdaptor_Surface.hxx>
 #include <GeomConvert.hxx>
 #include <GeomConvert_BSplineSurfaceToBezierSurface.hxx>
+#include <Geom2dConvert.hxx>
+#include <Geom2dConvert_BSplineCurveToBezierCurve.hxx>
 #include <Geom2d_BSplineCurve.hxx>
+#include <Geom2d_Conic.hxx>
 #include <Geom2d_BezierCurve.hxx>
 #include <Geom2d_Curve.hxx>
 #include <Geom2d_Line.hxx>
@@ -180,6 +186,8 @@ std::vector<gp_Pnt2d> decidingPoints(Handle(Geom2d_Curve) curve, double first, d
   return points;
 }
 
+void snapToPeriods(Rectangle& r, const Handle(Geom_Surface)& surface);
+
 Rectangle parameterRectangle(const TopoDS_Face& face, const Handle(Geom_Surface)& surface) {
   int wires = 0;
   for (TopoDS_Iterator it(face); it.More(); it.Next()) wires += it.Value().ShapeType() == TopAbs_WIRE ? 1 : 0;
@@ -253,8 +261,13 @@ Rectangle parameterRectangle(const TopoDS_Face& face, const Handle(Geom_Surface)
                                     "rectangle): trimmed faces are not supported yet",
                                     covered[side], sideNames[side], length)};
   }
-  // A closed face of a periodic surface spans one period (its pcurves' ends may overshoot it
-  // by rounding, and OCCT would wrap the excess into an empty trim).
+  snapToPeriods(r, surface);
+  return r;
+}
+
+// A closed face of a periodic surface spans one period (its pcurves' ends may overshoot it
+// by rounding, and OCCT would wrap the excess into an empty trim); refused when empty.
+void snapToPeriods(Rectangle& r, const Handle(Geom_Surface)& surface) {
   // Ends within tolerance of a multiple of the period are that multiple (the seam): OCCT's
   // conversions of quadrics fail on a full turn starting at -2e-13.
   const auto snapToPeriod = [](double& x, double period, double tol) {
@@ -274,7 +287,6 @@ Rectangle parameterRectangle(const TopoDS_Face& face, const Handle(Geom_Surface)
   if (!(r.u1 - r.u0 > r.tolU) || !(r.v1 - r.v0 > r.tolV))
     throw FaceRefused{CadFaceIssue::trimmed, fmt::format("has an empty parameter rectangle [{:.6g}, {:.6g}] x [{:.6g}, {:.6g}]",
                                                          r.u0, r.u1, r.v0, r.v1)};
-  return r;
 }
 
 // The surface on the rectangle as a non-periodic B-spline, exactly (see the contract).
@@ -363,12 +375,19 @@ void checkConversion(const Handle(Geom_Surface)& original, const Handle(Geom_BSp
   }
   double su0 = 0.0, su1 = 0.0, sv0 = 0.0, sv1 = 0.0;
   spline->Bounds(su0, su1, sv0, sv1);
+  const bool keepsParameters =
+      original->IsKind(STANDARD_TYPE(Geom_BSplineSurface)) || original->IsKind(STANDARD_TYPE(Geom_BezierSurface));
   double worst = 0.0;
   for (int a = 0; a < kConversionSamples; ++a)
     for (int b = 0; b < kConversionSamples; ++b) {
       const double s = (a + 0.5) / kConversionSamples, t = (b + 0.5) / kConversionSamples;
-      const gp_Pnt expected = original->Value(r.u0 + s * (r.u1 - r.u0), r.v0 + t * (r.v1 - r.v0));
-      const gp_Pnt got = spline->Value(su0 + s * (su1 - su0), sv0 + t * (sv1 - sv0));
+      // A B-spline or Bezier surface keeps its parameters (Segment may have snapped the ends
+      // to knots, so the spline's bounds need not be the rectangle's exactly); the others'
+      // conversions map the rectangle onto the spline's bounds.
+      const double U = su0 + s * (su1 - su0), V = sv0 + t * (sv1 - sv0);
+      const gp_Pnt expected = keepsParameters ? original->Value(U, V)
+                                              : original->Value(r.u0 + s * (r.u1 - r.u0), r.v0 + t * (r.v1 - r.v0));
+      const gp_Pnt got = spline->Value(U, V);
       worst = std::max(worst, expected.Distance(got));
     }
   if (!(worst <= kConversionTolerance * size) && spline->IsURational() + spline->IsVRational() > 0) {
@@ -393,18 +412,272 @@ void checkConversion(const Handle(Geom_Surface)& original, const Handle(Geom_BSp
                                   surfaceKind(original), worst, size > 0.0 ? worst / size : worst)};
 }
 
+// --- trimmed faces (see the contract's "trimmed faces") ------------------------------------
+
+// A box of the face's parameter plane.
+struct ParameterBox {
+  double u0, u1, v0, v1;
+  bool meets(const ParameterBox& other) const {
+    return u0 <= other.u1 && other.u0 <= u1 && v0 <= other.v1 && other.v0 <= v1;
+  }
+};
+
+// One rational Bezier arc of a trimming curve in the face's parameter plane, in homogeneous
+// coordinates (w u, w v, w), w > 0.
+using TrimArc = std::vector<std::array<double, 3>>;
+
+ParameterBox poleBox(const TrimArc& arc) {
+  ParameterBox box{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
+                   std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
+  for (const auto& p : arc) {
+    const double u = p[0] / p[2], v = p[1] / p[2];
+    box = {std::min(box.u0, u), std::max(box.u1, u), std::min(box.v0, v), std::max(box.v1, v)};
+  }
+  return box;
+}
+
+// Whether the arc may meet the box. false is proven: an arc with positive weights lies in the
+// convex hull of its poles, so in their box, and halves (de Casteljau on the homogeneous
+// poles, exact up to rounding, which the callers' margins cover) lie in theirs. true once a
+// half whose box meets the box is smaller than an eighth of it in both directions, or at
+// depth 40: conservatively "may meet".
+bool mayMeet(const TrimArc& arc, const ParameterBox& box) {
+  const double smallU = (box.u1 - box.u0) / 8.0, smallV = (box.v1 - box.v0) / 8.0;
+  std::vector<std::pair<TrimArc, int>> stack{{arc, 0}};
+  while (!stack.empty()) {
+    auto [poles, depth] = std::move(stack.back());
+    stack.pop_back();
+    const ParameterBox own = poleBox(poles);
+    if (!own.meets(box)) continue;
+    if ((own.u1 - own.u0 <= smallU && own.v1 - own.v0 <= smallV) || depth >= 40) return true;
+    // Halve: the left half's poles are the first points of each de Casteljau level, the
+    // right half's the last (reversed).
+    const std::size_t n = poles.size();
+    TrimArc left(n), right(n);
+    for (std::size_t level = 0; level < n; ++level) {
+      left[level] = poles[0];
+      right[n - 1 - level] = poles[n - 1 - level];
+      for (std::size_t i = 0; i + 1 < n - level; ++i)
+        for (std::size_t c = 0; c < 3; ++c) poles[i][c] = 0.5 * (poles[i][c] + poles[i + 1][c]);
+    }
+    stack.push_back({std::move(left), depth + 1});
+    stack.push_back({std::move(right), depth + 1});
+  }
+  return false;
+}
+
+// The face's trimming curves (every edge's pcurve, seam edges in both orientations) as rational
+// Bezier arcs, exactly: OCCT's conversion of lines, conics, B-spline and Bezier curves is
+// algebraic; any other kind is refused.
+std::vector<TrimArc> trimArcs(const TopoDS_Face& face) {
+  std::vector<TrimArc> arcs;
+  std::size_t index = 0;
+  for (TopExp_Explorer it(face, TopAbs_EDGE); it.More(); it.Next(), ++index) {
+    const TopoDS_Edge& edge = TopoDS::Edge(it.Current());
+    double first = 0.0, last = 0.0;
+    const Handle(Geom2d_Curve) pcurve = BRep_Tool::CurveOnSurface(edge, face, first, last);
+    if (pcurve.IsNull())
+      throw FaceRefused{CadFaceIssue::trimmed,
+                        fmt::format("has an edge ({}) without a curve in its parameter plane", index)};
+    Handle(Geom2d_Curve) basis = pcurve;
+    while (basis->IsKind(STANDARD_TYPE(Geom2d_TrimmedCurve)))
+      basis = Handle(Geom2d_TrimmedCurve)::DownCast(basis)->BasisCurve();
+    const bool exact = basis->IsKind(STANDARD_TYPE(Geom2d_Line)) || basis->IsKind(STANDARD_TYPE(Geom2d_Conic)) ||
+                       basis->IsKind(STANDARD_TYPE(Geom2d_BSplineCurve)) ||
+                       basis->IsKind(STANDARD_TYPE(Geom2d_BezierCurve));
+    if (!exact)
+      throw FaceRefused{CadFaceIssue::unsupportedSurface,
+                        fmt::format("has a trimming curve (edge {}) that is a {}, which has no exact B-spline form",
+                                    index, basis->DynamicType()->Name())};
+    if (!(last > first)) continue;  // a point: bounds nothing
+    const Handle(Geom2d_BSplineCurve) spline =
+        Geom2dConvert::CurveToBSplineCurve(new Geom2d_TrimmedCurve(pcurve, first, last));
+    Geom2dConvert_BSplineCurveToBezierCurve splitter(spline);
+    for (int a = 1; a <= splitter.NbArcs(); ++a) {
+      const Handle(Geom2d_BezierCurve) bezier = splitter.Arc(a);
+      TrimArc arc;
+      for (int i = 1; i <= bezier->NbPoles(); ++i) {
+        const gp_Pnt2d p = bezier->Pole(i);
+        const double w = bezier->Weight(i);
+        if (!(w > 0.0) || !std::isfinite(p.X()) || !std::isfinite(p.Y()))
+          throw FaceRefused{CadFaceIssue::unsupportedSurface,
+                            fmt::format("has a trimming curve (edge {}) with a pole ({}, {}) of weight {}", index,
+                                        p.X(), p.Y(), w)};
+        arc.push_back({w * p.X(), w * p.Y(), w});
+      }
+      arcs.push_back(std::move(arc));
+    }
+  }
+  if (arcs.empty()) throw FaceRefused{CadFaceIssue::trimmed, "is trimmed by no curve"};
+  return arcs;
+}
+
+// The rectangle of a trimmed face: its pcurves' bounds (BRepTools::UVBounds), within the
+// surface's bounds in a non-periodic direction, one period at most in a periodic one.
+Rectangle boundsRectangle(const TopoDS_Face& face, const Handle(Geom_Surface)& surface) {
+  Rectangle r{};
+  BRepTools::UVBounds(face, r.u0, r.u1, r.v0, r.v1);
+  double tolerance3d = 0.0;
+  for (TopExp_Explorer it(face, TopAbs_EDGE); it.More(); it.Next())
+    tolerance3d = std::max(tolerance3d, BRep_Tool::Tolerance(TopoDS::Edge(it.Current())));
+  const GeomAdaptor_Surface adaptor(surface);
+  r.tolU = std::max(Precision::PConfusion(), adaptor.UResolution(tolerance3d));
+  r.tolV = std::max(Precision::PConfusion(), adaptor.VResolution(tolerance3d));
+  double su0 = 0.0, su1 = 0.0, sv0 = 0.0, sv1 = 0.0;
+  surface->Bounds(su0, su1, sv0, sv1);
+  if (!surface->IsUPeriodic()) r.u0 = std::max(r.u0, su0), r.u1 = std::min(r.u1, su1);
+  if (!surface->IsVPeriodic()) r.v0 = std::max(r.v0, sv0), r.v1 = std::min(r.v1, sv1);
+  snapToPeriods(r, surface);
+  return r;
+}
+
+// The map from one Bezier piece's (s, t) in [0, 1]^2 (after the face's u reversal) to the
+// face's (u, v) (see the contract's "trimmed faces").
+class PieceParameters {
+ public:
+  PieceParameters(const Handle(Geom_Surface)& basis, const Handle(Geom_BSplineSurface)& spline, bool converted,
+                  const Rectangle& rectangle, double knotU0, double knotU1, double knotV0, double knotV1,
+                  bool reversed)
+      : basis_(basis), spline_(spline), converted_(converted), rectangle_(rectangle), knotU0_(knotU0),
+        knotU1_(knotU1), knotV0_(knotV0), knotV1_(knotV1), reversed_(reversed) {
+    periodU_ = basis->IsUPeriodic() ? basis->UPeriod() : 0.0;
+    periodV_ = basis->IsVPeriodic() ? basis->VPeriod() : 0.0;
+    const double uc = 0.5 * (knotU0 + knotU1), vc = 0.5 * (knotV0 + knotV1);
+    const gp_Pnt2d centre = rawParameters(uc, vc);
+    // The centre's representative nearest the rectangle's middle (a point of the rectangle is
+    // within half a period of it); every other value is taken nearest the centre's.
+    centreU_ = nearest(centre.X(), 0.5 * (rectangle.u0 + rectangle.u1), periodU_);
+    centreV_ = nearest(centre.Y(), 0.5 * (rectangle.v0 + rectangle.v1), periodV_);
+    marginU_ = 1e-8 * (rectangle.u1 - rectangle.u0);
+    marginV_ = 1e-8 * (rectangle.v1 - rectangle.v0);
+    if (converted_) {
+      // u = phi(U) and v = psi(V) alone: checked at the quarter points.
+      for (const double f : {0.25, 0.75}) {
+        const double driftU =
+            std::abs(nearest(rawParameters(uc, knotV0 + f * (knotV1 - knotV0)).X(), centreU_, periodU_) - centreU_);
+        const double driftV =
+            std::abs(nearest(rawParameters(knotU0 + f * (knotU1 - knotU0), vc).Y(), centreV_, periodV_) - centreV_);
+        if (!(driftU <= 100.0 * marginU_) || !(driftV <= 100.0 * marginV_))
+          throw FaceRefused{CadFaceIssue::unsupportedSurface,
+                            fmt::format("is {} whose B-spline form mixes its parameters (u moves by {:.3g}, v by "
+                                        "{:.3g} along the other): its trimming curves cannot be followed",
+                                        surfaceKind(basis), driftU, driftV)};
+      }
+    }
+  }
+
+  // The face-parameter box that the patch cell maps onto, widened by the margins.
+  ParameterBox box(const ParameterCell& cell) {
+    const double sA = reversed_ ? 1.0 - cell.u1 : cell.u0, sB = reversed_ ? 1.0 - cell.u0 : cell.u1;
+    const double ua = faceU(knotU0_ + sA * (knotU1_ - knotU0_)), ub = faceU(knotU0_ + sB * (knotU1_ - knotU0_));
+    const double va = faceV(knotV0_ + cell.v0 * (knotV1_ - knotV0_)), vb = faceV(knotV0_ + cell.v1 * (knotV1_ - knotV0_));
+    return {std::min(ua, ub) - marginU_, std::max(ua, ub) + marginU_, std::min(va, vb) - marginV_,
+            std::max(va, vb) + marginV_};
+  }
+
+ private:
+  static double nearest(double x, double reference, double period) {
+    return period > 0.0 ? x - period * std::round((x - reference) / period) : x;
+  }
+
+  // The basis surface's parameters of the B-spline's point (U, V).
+  gp_Pnt2d rawParameters(double U, double V) const {
+    if (!converted_) return {U, V};
+    const gp_Pnt p = spline_->Value(U, V);
+    double u = 0.0, v = 0.0;
+    if (const auto plane = Handle(Geom_Plane)::DownCast(basis_); !plane.IsNull()) {
+      ElSLib::Parameters(plane->Pln(), p, u, v);
+    } else if (const auto cylinder = Handle(Geom_CylindricalSurface)::DownCast(basis_); !cylinder.IsNull()) {
+      ElSLib::Parameters(cylinder->Cylinder(), p, u, v);
+    } else if (const auto cone = Handle(Geom_ConicalSurface)::DownCast(basis_); !cone.IsNull()) {
+      ElSLib::Parameters(cone->Cone(), p, u, v);
+    } else if (const auto sphere = Handle(Geom_SphericalSurface)::DownCast(basis_); !sphere.IsNull()) {
+      ElSLib::Parameters(sphere->Sphere(), p, u, v);
+    } else if (const auto torus = Handle(Geom_ToroidalSurface)::DownCast(basis_); !torus.IsNull()) {
+      ElSLib::Parameters(torus->Torus(), p, u, v);
+    } else {
+      const Rectangle& r = rectangle_;
+      const double padU = 0.1 * (r.u1 - r.u0), padV = 0.1 * (r.v1 - r.v0);
+      GeomAPI_ProjectPointOnSurf projection(p, basis_, r.u0 - padU, r.u1 + padU, r.v0 - padV, r.v1 + padV);
+      if (projection.NbPoints() == 0 || !(projection.LowerDistance() <= kConversionTolerance * (1.0 + p.XYZ().Modulus())))
+        throw FaceRefused{CadFaceIssue::unsupportedSurface,
+                          fmt::format("is {} whose point ({:.6g}, {:.6g}, {:.6g}) has no parameters on it: its trimming "
+                                      "curves cannot be followed",
+                                      surfaceKind(basis_), p.X(), p.Y(), p.Z())};
+      projection.LowerDistanceParameters(u, v);
+    }
+    return {u, v};
+  }
+
+  double faceU(double U) {
+    const auto found = cacheU_.find(U);
+    if (found != cacheU_.end()) return found->second;
+    const double u = nearest(rawParameters(U, 0.5 * (knotV0_ + knotV1_)).X(), centreU_, periodU_);
+    cacheU_.emplace(U, u);
+    return u;
+  }
+  double faceV(double V) {
+    const auto found = cacheV_.find(V);
+    if (found != cacheV_.end()) return found->second;
+    const double v = nearest(rawParameters(0.5 * (knotU0_ + knotU1_), V).Y(), centreV_, periodV_);
+    cacheV_.emplace(V, v);
+    return v;
+  }
+
+  Handle(Geom_Surface) basis_;
+  Handle(Geom_BSplineSurface) spline_;
+  bool converted_;
+  Rectangle rectangle_;
+  double knotU0_, knotU1_, knotV0_, knotV1_;
+  bool reversed_;
+  double periodU_ = 0.0, periodV_ = 0.0, centreU_ = 0.0, centreV_ = 0.0, marginU_ = 0.0, marginV_ = 0.0;
+  std::map<double, double> cacheU_, cacheV_;
+};
+
+// Where a face-parameter box lies with respect to the face: boundary when a trimming arc may
+// meet it, else its centre's side by OCCT's classifier (ON: boundary).
+CellPlace classifyBox(const TopoDS_Face& face, const std::vector<TrimArc>& arcs, const ParameterBox& box) {
+  for (const TrimArc& arc : arcs)
+    if (mayMeet(arc, box)) return CellPlace::boundary;
+  const BRepClass_FaceClassifier classifier(face, gp_Pnt2d(0.5 * (box.u0 + box.u1), 0.5 * (box.v0 + box.v1)),
+                                            Precision::PConfusion());
+  switch (classifier.State()) {
+    case TopAbs_IN: return CellPlace::inside;
+    case TopAbs_OUT: return CellPlace::outside;
+    default: return CellPlace::boundary;
+  }
+}
+
 // What facePatches is doing, for the message when OCCT throws.
 struct Stage {
   const char* what = "reading the face";
   std::optional<Rectangle> rectangle;  // once known
 };
 
-std::vector<BezierPatch> facePatches(const TopoDS_Face& face, Units units, Stage& stage, bool acceptRational) {
+// A face's patches; a trimmed face's (acceptTrimmed) as pieces with their roles.
+struct FacePatches {
+  std::vector<BezierPatch> patches;
+  std::vector<PieceRole> roles;
+  bool trimmed = false;
+  double largestSpreadRad = 0.0;
+};
+
+FacePatches facePatches(const TopoDS_Face& face, Units units, Stage& stage, const CadImportOptions& options,
+                        std::size_t& trimBudget) {
+  const bool acceptRational = options.acceptRational;
   const Handle(Geom_Surface) located = BRep_Tool::Surface(face);  // the face's location applied
   if (located.IsNull()) throw FaceRefused{CadFaceIssue::unsupportedSurface, "has no surface"};
   const Handle(Geom_Surface) basis = exactBasis(located);
   stage.what = "checking its boundary";
-  const Rectangle rectangle = parameterRectangle(face, basis);
+  FacePatches result;
+  Rectangle rectangle{};
+  try {
+    rectangle = parameterRectangle(face, basis);
+  } catch (const FaceRefused& refused) {
+    if (refused.issue != CadFaceIssue::trimmed || !options.acceptTrimmed) throw;
+    result.trimmed = true;
+    rectangle = boundsRectangle(face, basis);
+  }
   stage.what = "converting it to a B-spline";
   stage.rectangle = rectangle;
   const Handle(Geom_BSplineSurface) spline = bsplineOn(basis, rectangle);
@@ -456,7 +729,46 @@ std::vector<BezierPatch> facePatches(const TopoDS_Face& face, Units units, Stage
     throw FaceRefused{CadFaceIssue::invalidPatch, fmt::format("has an invalid Bezier {} ({}, {} pieces)", message,
                                                               surfaceKind(basis), patches.size())};
   }
-  return patches;
+  if (!result.trimmed) {
+    result.roles.assign(patches.size(), PieceRole::inside);
+    result.patches = std::move(patches);
+    return result;
+  }
+  stage.what = "following its trimming curves";
+  const std::vector<TrimArc> arcs = trimArcs(face);
+  const bool converted =
+      !basis->IsKind(STANDARD_TYPE(Geom_BSplineSurface)) && !basis->IsKind(STANDARD_TYPE(Geom_BezierSurface));
+  TColStd_Array1OfReal knotsU(1, splitter.NbUPatches() + 1), knotsV(1, splitter.NbVPatches() + 1);
+  splitter.UKnots(knotsU);
+  splitter.VKnots(knotsV);
+  std::size_t index = 0;
+  for (int i = 1; i <= pieces.UpperRow(); ++i)
+    for (int j = 1; j <= pieces.UpperCol(); ++j, ++index) {
+      PieceParameters parameters(basis, spline, converted, rectangle, knotsU(i), knotsU(i + 1), knotsV(j),
+                                 knotsV(j + 1), reversed);
+      TrimSplitOptions split = options.trimSplit;
+      split.maxPieces = std::min(split.maxPieces, trimBudget);
+      if (split.maxPieces == 0)
+        throw Error(fmt::format("more than {} pieces in all follow the trimming curves of the part's faces",
+                                options.maxTrimPieces));
+      TrimSplit pieceSplit;
+      try {
+        pieceSplit = splitTrimmedPatch(
+            patches[index], [&](const ParameterCell& cell) { return classifyBox(face, arcs, parameters.box(cell)); },
+            split);
+      } catch (const Error& error) {
+        throw FaceRefused{CadFaceIssue::trimmed, fmt::format("(piece {}): {}", index, error.what())};
+      }
+      trimBudget -= pieceSplit.pieces.size();
+      result.largestSpreadRad = std::max(result.largestSpreadRad, pieceSplit.largestSpreadRad);
+      for (TrimmedPiece& piece : pieceSplit.pieces) {
+        result.patches.push_back(std::move(piece.patch));
+        result.roles.push_back(piece.role);
+      }
+    }
+  if (result.patches.empty())
+    throw FaceRefused{CadFaceIssue::trimmed, "lies outside its own trimming curves (no piece of it is inside)"};
+  return result;
 }
 
 }  // namespace
@@ -497,14 +809,15 @@ CadImport convertFaces(const CadFile& transferred, const std::string& path, cons
   result.surface.units = transferred.units;
   result.fileUnit = transferred.fileUnit;
 
+  std::size_t trimBudget = options.maxTrimPieces;
   std::size_t index = 0;
   for (TopExp_Explorer it(transferred.shape, TopAbs_FACE); it.More(); it.Next(), ++index) {
     const TopoDS_Face& face = TopoDS::Face(it.Current());
     try {
-      std::vector<BezierPatch> patches;
+      FacePatches patches;
       Stage stage;
       try {
-        patches = facePatches(face, transferred.units, stage, options.acceptRational);
+        patches = facePatches(face, transferred.units, stage, options, trimBudget);
       } catch (const Standard_Failure& failure) {
         throw FaceRefused{CadFaceIssue::unsupportedSurface,
                           fmt::format("could not be converted: OpenCASCADE failed {}{} ({})", stage.what,
@@ -514,10 +827,13 @@ CadImport convertFaces(const CadFile& transferred, const std::string& path, cons
                                                       : std::string(),
                                       detail::occtMessage(failure))};
       }
-      for (BezierPatch& patch : patches) {
-        result.surface.patches.push_back(std::move(patch));
+      for (std::size_t p = 0; p < patches.patches.size(); ++p) {
+        result.surface.patches.push_back(std::move(patches.patches[p]));
         result.patchFaces.push_back(index);
+        result.patchRoles.push_back(patches.roles[p]);
       }
+      if (patches.trimmed) ++result.trimmedFaces;
+      result.largestSpreadRad = std::max(result.largestSpreadRad, patches.largestSpreadRad);
     } catch (const FaceRefused& refused) {
       const std::string name = detail::cadFaceName(transferred, face, index);
       if (!options.skipUnsupportedFaces) throw Error(fmt::format("{}: {} {}", path, name, refused.reason));

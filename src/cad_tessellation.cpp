@@ -144,13 +144,11 @@ std::size_t CadPart::faces() const { return impl_->faces; }
 Vec3 CadPart::boxLow() const { return impl_->low; }
 Vec3 CadPart::boxHigh() const { return impl_->high; }
 
-CadImport CadPart::exactFaces(bool acceptRational) const {
+CadImport CadPart::exactFaces(CadImportOptions options) const {
   const auto start = std::chrono::steady_clock::now();
   const std::lock_guard<std::mutex> lock(detail::cadMutex());
   const detail::QuietMessages quiet;
-  CadImportOptions options;
   options.skipUnsupportedFaces = true;
-  options.acceptRational = acceptRational;
   CadImport result = detail::convertFaces(impl_->file, impl_->path, options, false);
   result.format = impl_->format;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

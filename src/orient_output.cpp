@@ -948,6 +948,31 @@ std::string orientationToJson(const OptimalSlicing& result, double toleranceDeg)
   return json::format(documentJson(result, toleranceDeg));
 }
 
+std::string trimmedOrientationToJson(const OptimalSlicing& result, double toleranceDeg, const TrimmedFacts& facts) {
+  Json document = documentJson(result, toleranceDeg);
+  const Json seconds = document["seconds"];
+  document.erase("seconds");
+  Json trimmed;
+  trimmed["faces"] = facts.faces;
+  trimmed["inside_pieces"] = facts.insidePieces;
+  trimmed["boundary_pieces"] = facts.boundaryPieces;
+  trimmed["spread_deg"] = toDegrees(facts.spreadRad);
+  trimmed["largest_spread_deg"] = toDegrees(facts.largestSpreadRad);
+  trimmed["alpha_lower_deg"] = toDegrees(result.certified ? result.certifiedAlphaRad : result.alphaRad);
+  if (facts.inside != nullptr) {
+    trimmed["alpha_upper_deg"] = toDegrees(facts.inside->alphaRad);
+    trimmed["upper_normal"] = {facts.inside->normal.x, facts.inside->normal.y, facts.inside->normal.z};
+    trimmed["seconds"] = facts.inside->seconds;
+  } else {
+    trimmed["alpha_upper_deg"] = nullptr;
+    trimmed["upper_normal"] = nullptr;
+    trimmed["seconds"] = 0.0;
+  }
+  document["trimmed"] = std::move(trimmed);
+  document["seconds"] = seconds;
+  return json::format(document);
+}
+
 std::string gaussMapSphereSvg(const OptimalSlicing& result) {
   requireFinite(result);
   const std::array<SphereView, 2> views = sphereViews(result);

@@ -6,7 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <limits>
 #include <map>
@@ -39,6 +41,7 @@
 #include "scallop/error.hpp"
 #include "scallop/gcode_reader.hpp"
 #include "scallop/mesh_slicing.hpp"
+#include "scallop/optimal_slicing.hpp"
 #include "scallop/surface_io.hpp"
 
 namespace {
@@ -326,6 +329,155 @@ TEST_F(CadTessellationTest, TheTrimmedFaceOrientationAgreesWithABruteForceOverIt
   EXPECT_GE(sampledDeg, 78.03);
 }
 
+// --- trimmed faces as pieces (cad_import.hpp's acceptTrimmed) ---------------------------------
+
+// The area of a patch by 8 x 8 Gauss-Legendre quadrature of |r_u x r_v|.
+double patchArea(const scallop::BezierPatch& patch) {
+  static const std::array<double, 8> nodes{-0.9602898564975363, -0.7966664774136267, -0.5255324099163290,
+                                           -0.1834346424956498, 0.1834346424956498,  0.5255324099163290,
+                                           0.7966664774136267,  0.9602898564975363};
+  static const std::array<double, 8> weights{0.1012285362903763, 0.2223810344533745, 0.3137066278833262,
+                                             0.3626837833783620, 0.3626837833783620, 0.3137066278833262,
+                                             0.2223810344533745, 0.1012285362903763};
+  double area = 0.0;
+  for (std::size_t i = 0; i < 8; ++i)
+    for (std::size_t k = 0; k < 8; ++k)
+      area += 0.25 * weights[i] * weights[k] *
+              norm(scallop::normalVector(patch, 0.5 * (1.0 + nodes[i]), 0.5 * (1.0 + nodes[k])));
+  return area;
+}
+
+// The disk-trimmed paper-1 face through the importer: its inside pieces lie over the disk, its
+// boundary pieces straddle the circle, the face's area (a polar quadrature written here) lies
+// between the inside pieces' and all pieces', and the slicing of the pieces brackets alpha*
+// against the normals sampled densely over the disk (scallop's derivatives at points chosen
+// here, not OCCT's classification).
+TEST_F(CadTessellationTest, ATrimmedFaceBecomesPiecesThatFollowItsTrimmingCurve) {
+  const Surface paper = exampleFile("paper-1");
+  const fs::path path = dir_ / "disk.step";
+  writeStep(paperDiskFace(paper), path, "INCH");
+  scallop::CadImportOptions options;
+  options.acceptTrimmed = true;
+  const scallop::CadImport imported = scallop::importCad(path.string(), options);
+  EXPECT_EQ(imported.trimmedFaces, 1u);
+  ASSERT_EQ(imported.patchRoles.size(), imported.surface.patches.size());
+  EXPECT_LE(imported.largestSpreadRad, options.trimSplit.normalSpreadRad);
+  double insideArea = 0.0, allArea = 0.0;
+  std::size_t boundary = 0;
+  for (std::size_t p = 0; p < imported.surface.patches.size(); ++p) {
+    const scallop::BezierPatch& piece = imported.surface.patches[p];
+    double nearest = kInf, farthest = 0.0, low = kInf, high = -kInf;
+    for (int i = 0; i <= 8; ++i)
+      for (int k = 0; k <= 8; ++k) {
+        const Vec3 q = scallop::point(piece, i / 8.0, k / 8.0);
+        const double r = std::hypot(q.x - 1.5, q.y - 1.5);
+        nearest = std::min(nearest, r);
+        farthest = std::max(farthest, r);
+        low = std::min(low, r), high = std::max(high, r);
+        // Every piece is the paper's surface (x = 3 v, y = 3 u).
+        ASSERT_NEAR(q.z, scallop::point(paper.patches[0], q.y / 3.0, q.x / 3.0).z, 1e-9);
+      }
+    const double area = patchArea(piece);
+    allArea += area;
+    if (imported.patchRoles[p] == scallop::PieceRole::inside) {
+      insideArea += area;
+      EXPECT_LE(farthest, 0.9 + 1e-9) << "inside piece " << p;
+    } else {
+      ++boundary;
+      const double slack = 0.25 * (high - low);
+      EXPECT_LE(nearest, 0.9 + slack) << "boundary piece " << p;
+      EXPECT_GE(farthest, 0.9 - slack) << "boundary piece " << p;
+    }
+  }
+  EXPECT_GT(boundary, 10u);
+  // The face's area: r in [0, 0.3] of the parameter disk around (0.5, 0.5), 24 Gauss points
+  // radially (by 3 panels of 8) and 128 angles (periodic: the trapezoid rule is spectral).
+  double faceArea = 0.0;
+  static const std::array<double, 8> x{-0.9602898564975363, -0.7966664774136267, -0.5255324099163290,
+                                       -0.1834346424956498, 0.1834346424956498,  0.5255324099163290,
+                                       0.7966664774136267,  0.9602898564975363};
+  static const std::array<double, 8> w{0.1012285362903763, 0.2223810344533745, 0.3137066278833262,
+                                       0.3626837833783620, 0.3626837833783620, 0.3137066278833262,
+                                       0.2223810344533745, 0.1012285362903763};
+  for (int panel = 0; panel < 3; ++panel)
+    for (std::size_t i = 0; i < 8; ++i) {
+      const double r = 0.1 * (panel + 0.5 * (1.0 + x[i]));
+      for (int k = 0; k < 128; ++k) {
+        const double t = 2.0 * M_PI * k / 128.0;
+        faceArea += 0.05 * w[i] * (2.0 * M_PI / 128.0) * r *
+                    norm(scallop::normalVector(paper.patches[0], 0.5 + r * std::sin(t), 0.5 + r * std::cos(t)));
+      }
+    }
+  std::printf("[          ] disk face: area %.6f in^2, inside pieces %.6f, all pieces %.6f (%zu pieces, %zu on the "
+              "circle)\n",
+              faceArea, insideArea, allArea, imported.surface.patches.size(), boundary);
+  EXPECT_LE(insideArea, faceArea * (1.0 + 1e-9));
+  EXPECT_GE(allArea, faceArea * (1.0 - 1e-9));
+  EXPECT_GT(insideArea, 0.8 * faceArea);
+
+  Surface inside{imported.surface.units, {}};
+  for (std::size_t p = 0; p < imported.surface.patches.size(); ++p)
+    if (imported.patchRoles[p] == scallop::PieceRole::inside) inside.patches.push_back(imported.surface.patches[p]);
+  const scallop::OptimalSlicing lower = scallop::optimalSlicing(imported.surface);
+  scallop::OptimalSlicingOptions upperOptions;
+  upperOptions.certify = false;
+  const scallop::OptimalSlicing upper = scallop::optimalSlicing(inside, upperOptions);
+  ASSERT_TRUE(lower.certified);
+  std::vector<Vec3> normals;
+  for (int i = 0; i <= 60; ++i)
+    for (int k = 0; k < 120; ++k) {
+      const double r = 0.9 * std::sqrt(i / 60.0) * (1.0 - 1e-9), t = 2.0 * M_PI * k / 120.0;
+      const double px = 1.5 + r * std::cos(t), py = 1.5 + r * std::sin(t);
+      normals.push_back(scallop::unitNormal(paper.patches[0], py / 3.0, px / 3.0));
+    }
+  double clearance = M_PI / 2.0;
+  for (const Vec3& n : normals)
+    clearance = std::min(clearance, std::atan2(norm(cross(lower.normal, n)), std::abs(dot(lower.normal, n))));
+  const double sampledCap = scallop::optimalNormalSlicing(normals).alphaRad;
+  std::printf("[          ] disk face: alpha* in [%.4f, %.4f] deg; N*'s clearance from the samples %.4f deg, their "
+              "cap %.4f deg\n",
+              lower.certifiedAlphaRad * 180.0 / M_PI, upper.alphaRad * 180.0 / M_PI, clearance * 180.0 / M_PI,
+              sampledCap * 180.0 / M_PI);
+  EXPECT_GE(clearance, lower.certifiedAlphaRad - 1e-12);
+  EXPECT_LE(lower.certifiedAlphaRad, sampledCap);
+  EXPECT_LE(lower.certifiedAlphaRad, upper.alphaRad);
+  EXPECT_LE(sampledCap - lower.certifiedAlphaRad, 2.0 * options.trimSplit.normalSpreadRad);
+}
+
+// Real data: OCCT's screw.step (8 of its 10 faces trimmed, helical B-spline flanks): the
+// certified N* keeps its angle from every exact normal OCCT samples on the faces (at the nodes
+// and inside the triangles of its tessellation), and that sample's empty cap, an upper bound
+// of alpha*, is at least the certified bound.
+TEST(CadTrimmedSamples, ScrewStepsCertifiedDirectionClearsEveryNormalOcctSamples) {
+  const std::string path = kOcctSamples + "/step/screw.step";
+  if (!fs::exists(path)) GTEST_FAIL() << path << " is missing: Debian's occt-misc package installs it";
+  const CadPart part(path);
+  scallop::CadImportOptions options;
+  options.acceptTrimmed = true;
+  options.acceptRational = true;
+  options.trimSplit.normalSpreadRad = 4.0 * M_PI / 180.0;
+  const scallop::CadImport imported = part.exactFaces(options);
+  ASSERT_TRUE(imported.skipped.empty());
+  EXPECT_EQ(imported.trimmedFaces, 8u);
+  const scallop::OptimalSlicing lower = scallop::optimalSlicing(imported.surface);
+  ASSERT_TRUE(lower.certified);
+  scallop::TessellationOptions tessellation;
+  tessellation.deflection = 0.01;
+  tessellation.angularDeflection = 0.1;
+  const CadTessellation mesh = part.tessellate(tessellation);
+  ASSERT_GT(mesh.sampledNormals.size(), 5000u);
+  double clearance = M_PI / 2.0;
+  for (const Vec3& n : mesh.sampledNormals)
+    clearance = std::min(clearance, std::atan2(norm(cross(lower.normal, n)), std::abs(dot(lower.normal, n))));
+  const double sampledCap = scallop::optimalNormalSlicing(mesh.sampledNormals).alphaRad;
+  std::printf("[          ] screw.step: certified alpha >= %.4f deg; N*'s clearance from %zu OCCT normals %.4f deg, "
+              "their cap %.4f deg\n",
+              lower.certifiedAlphaRad * 180.0 / M_PI, mesh.sampledNormals.size(), clearance * 180.0 / M_PI,
+              sampledCap * 180.0 / M_PI);
+  EXPECT_GE(clearance, lower.certifiedAlphaRad - 1e-9);
+  EXPECT_LE(lower.certifiedAlphaRad, sampledCap + 1e-9);
+}
+
 // --- exact heights ----------------------------------------------------------------------------
 
 TEST_F(CadTessellationTest, ExactHeightsOfThePocketBlockAreItsClosedForm) {
@@ -502,7 +654,7 @@ TEST_F(CadTessellationCli, PlanAndVerifyOpenCascadesSampleStepAndIgesParts) {
 
 TEST_F(CadTessellationCli, OrientTakesAPartWithTrimmedAndRationalFacesBySampledNormals) {
   writeStep(pocketBlock(), workDir_ / "pocket.step", "MM");
-  const scallop::test::RunResult orient = run("orient pocket.step --json o.json");
+  const scallop::test::RunResult orient = run("orient pocket.step --tessellate --json o.json");
   ASSERT_EQ(orient.exitCode, 0) << orient.err;
   EXPECT_NE(orient.err.find("alpha* <= "), std::string::npos) << orient.err;
   EXPECT_NE(orient.err.find("not certified"), std::string::npos) << orient.err;
@@ -513,8 +665,40 @@ TEST_F(CadTessellationCli, OrientTakesAPartWithTrimmedAndRationalFacesBySampledN
   EXPECT_GE(json["alpha_deg"].get<double>(), 45.0 - 1e-9);
   EXPECT_LE(json["alpha_deg"].get<double>(), 45.05);
   fs::remove(workDir_ / "o.json");
-  expectCleanFailure(run("orient pocket.step --svg-dir figs"), {"pocket.step", "--svg-dir", "tessellated"},
+  expectCleanFailure(run("orient pocket.step --tessellate --svg-dir figs"), {"pocket.step", "--svg-dir", "tessellated"},
                      "pocket.step");
+}
+
+// Without --tessellate the pocket block's trimmed faces (the top around the pocket, the pocket's
+// floor) are pieces that follow their circles, its cylinder a rational patch: alpha* = 45 deg
+// (the planes' normals +-z and the walls' horizontal ones), bracketed by a certified lower bound
+// and the inside pieces' optimum.
+TEST_F(CadTessellationCli, OrientBracketsATrimmedPartsAlphaBetweenCertifiedBounds) {
+  writeStep(pocketBlock(), workDir_ / "pocket.step", "MM");
+  const scallop::test::RunResult orient = run("orient pocket.step --json o.json --svg-dir figs");
+  ASSERT_EQ(orient.exitCode, 0) << orient.err;
+  EXPECT_NE(orient.err.find("2 trimmed faces"), std::string::npos) << orient.err;
+  EXPECT_NE(orient.err.find("certified over the faces"), std::string::npos) << orient.err;
+  const auto json = nlohmann::json::parse(scallop::test::readFile(workDir_ / "o.json"));
+  EXPECT_EQ(json["certified"], true);
+  const auto& trimmed = json["trimmed"];
+  EXPECT_EQ(trimmed["faces"], 2);
+  const double lower = trimmed["alpha_lower_deg"].get<double>(), upper = trimmed["alpha_upper_deg"].get<double>();
+  EXPECT_LE(lower, 45.0);
+  EXPECT_GE(upper, 45.0);
+  EXPECT_GE(lower, 44.99);
+  EXPECT_LE(upper, 45.01);
+  EXPECT_NEAR(std::abs(json["normal"][2].get<double>()), std::sqrt(0.5), 1e-3);
+  EXPECT_TRUE(fs::exists(workDir_ / "figs" / "gauss-map.svg"));
+  fs::remove_all(workDir_ / "figs");
+  fs::remove(workDir_ / "o.json");
+  expectCleanFailure(run("orient pocket.step --trim-spread 0 --json o.json"), {"trim spread", "0"}, "pocket.step");
+  expectCleanFailure(run("orient pocket.step --trim-spread 20 --json o.json"), {"trim spread", "20"}, "pocket.step");
+  expectCleanFailure(run("orient pocket.step --patches 0-3 --json o.json"), {"pocket.step", "--patches", "trimmed"},
+                     "pocket.step");
+  expectCleanFailure(run("orient --example paper-1 --trim-spread 1 --json o.json"), {"--trim-spread", "trimmed"},
+                     "pocket.step");
+  fs::remove(workDir_ / "pocket.step");
 }
 
 TEST_F(CadTessellationCli, TessellationOptionsAreRefusedWhereTheyDoNotApply) {

@@ -44,6 +44,24 @@
 //           CadImportOptions::acceptRational: then each piece is a rational patch, its poles
 //           and weights as they are (a REVERSED face's reversed alike). Approximating
 //           silently is not allowed. A piece whose weights are all equal is polynomial.
+//         - trimmed faces (CadImportOptions::acceptTrimmed; otherwise refused as "trimmed"):
+//           a face that is not a parameter rectangle is converted on the rectangle of its
+//           pcurves' bounds (BRepTools::UVBounds, snapped to the period on periodic surfaces)
+//           and each Bezier patch split by trimmed_patch.hpp's splitTrimmedPatch against the
+//           face's trimming curves. Cells are classified in the face's own parameters: a
+//           patch's (s, t) maps to the B-spline's (U, V) affinely, and (U, V) to the surface's
+//           (u, v) by u = phi(U), v = psi(V): the identity (up to the period) for B-spline
+//           and Bezier surfaces, the inverse of OCCT's conversion for the others (computed
+//           by ElSLib's closed forms for quadrics and projection for swept surfaces, and
+//           checked to be separable: u independent of V and v of U at the quarter points).
+//           phi and psi are monotone (a conic's rational parametrisation is), so a cell maps
+//           onto the box [phi(U0), phi(U1)] x [psi(V0), psi(V1)], widened by 1e-8 of the
+//           rectangle. Every pcurve (lines, conics, B-spline and Bezier curves; offset curves
+//           are refused) is converted exactly to rational Bezier arcs; a cell's box that no
+//           arc's control polygon box meets (arcs subdivided until their boxes are an eighth
+//           of the cell's) lies wholly inside or outside the face, decided at its centre by
+//           OCCT's BRepClass_FaceClassifier; a box that some arc may meet is "boundary".
+//           CadImport::patchRoles tells the pieces apart; at most maxTrimPieces in all.
 //         - validity: each patch must satisfy surface.hpp's contract (degree <= 20, regular);
 //           a face with a patch that does not is refused with validateSurface's reason.
 // Output: the surface (at least one patch), and per patch the face it came from.
@@ -71,6 +89,7 @@
 #include <vector>
 
 #include "scallop/surface.hpp"
+#include "scallop/trimmed_patch.hpp"
 
 namespace scallop {
 
@@ -95,6 +114,15 @@ struct CadImportOptions {
   /// instead of being refused: for `scallop orient`, whose Gauss map takes them. The other
   /// computations take polynomial patches only (surface.hpp's requirePolynomial).
   bool acceptRational = false;
+  /// Trimmed faces (not a parameter rectangle of their surface) become pieces of their Bezier
+  /// patches that follow the trimming curves (trimmed_patch.hpp) instead of being refused: for
+  /// `scallop orient`, whose Gauss map then sees only the face's normals (see the contract's
+  /// "trimmed faces"). The other computations take untrimmed faces only.
+  bool acceptTrimmed = false;
+  /// How finely boundary pieces follow the trimming curves (per patch).
+  TrimSplitOptions trimSplit{};
+  /// Budget of pieces over all trimmed faces of the file.
+  std::size_t maxTrimPieces = 100000;
 };
 
 /// Why a face was refused.
@@ -122,6 +150,11 @@ struct CadImport {
   std::size_t faces = 0;                 ///< faces in the file
   std::vector<std::size_t> patchFaces;   ///< per patch of `surface`, its face
   std::vector<SkippedFace> skipped;      ///< faces left out (skipUnsupportedFaces)
+  /// Per patch: inside its face, or a boundary piece of a trimmed face (acceptTrimmed; a
+  /// boundary piece may reach beyond the trimming curve by less than its cell).
+  std::vector<PieceRole> patchRoles;
+  std::size_t trimmedFaces = 0;          ///< faces taken as pieces (acceptTrimmed)
+  double largestSpreadRad = 0.0;         ///< over boundary pieces (trimmed_patch.hpp's spread)
   double seconds = 0.0;                  ///< wall time of the import
 };
 

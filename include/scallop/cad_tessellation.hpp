@@ -122,9 +122,9 @@ class CadPart {
 
   /// The faces cad_import.hpp converts to exact Bezier patches, and those it cannot (as
   /// importCad with skipUnsupportedFaces, but a part with none left is not refused: its
-  /// surface is then empty). No faces skipped: the part can be planned exactly. With
-  /// acceptRational, rational faces are rational patches (orient's).
-  CadImport exactFaces(bool acceptRational = false) const;
+  /// surface is then empty). No faces skipped: the part can be planned exactly. `options`
+  /// as importCad's (acceptRational, acceptTrimmed: orient's); skipUnsupportedFaces is set.
+  CadImport exactFaces(CadImportOptions options = {}) const;
 
   /// See the contract's Tessellation and Deviation.
   CadTessellation tessellate(const TessellationOptions& options) const;

@@ -61,6 +61,26 @@ constexpr double toDegrees(double radians) { return radians * (180.0 / std::numb
 /// The JSON form of `result` (see above); `toleranceDeg` is recorded as "tolerance_deg".
 std::string orientationToJson(const OptimalSlicing& result, double toleranceDeg);
 
+/// What a part with trimmed faces adds to its orientation (cad_import.hpp's acceptTrimmed).
+struct TrimmedFacts {
+  std::size_t faces = 0;            ///< trimmed faces
+  std::size_t insidePieces = 0;     ///< pieces inside their faces (untrimmed faces' patches too)
+  std::size_t boundaryPieces = 0;   ///< pieces crossing (or touching) a trimming curve
+  double spreadRad = 0.0;           ///< the normal spread asked of boundary pieces
+  double largestSpreadRad = 0.0;    ///< the largest a boundary piece has
+  const OptimalSlicing* inside = nullptr;  ///< the slicing of the inside pieces alone, if any
+};
+
+/// orientationToJson of a part with trimmed faces: `result` is the slicing of all its pieces
+/// (inside and boundary: a superset of the faces' normals, so its N* keeps at least its
+/// certified alpha from every normal of the part), with, before "seconds", "trimmed":
+/// {"faces", "inside_pieces", "boundary_pieces", "spread_deg", "largest_spread_deg",
+///  "alpha_lower_deg" (the certified alpha, or alpha_deg when not certified),
+///  "alpha_upper_deg" (alpha* of the inside pieces alone, a subset of the normals: no
+///  direction does better on the part, within the Gauss map's tolerance; null without inside
+///  pieces), "upper_normal" (that slicing's N*, or null), "seconds" (of that slicing)}.
+std::string trimmedOrientationToJson(const OptimalSlicing& result, double toleranceDeg, const TrimmedFacts& facts);
+
 /// The JSON form of a mesh's optimal slicing (mesh_slicing.hpp): {"input": "mesh", "source",
 /// "format": "binary"|"ascii", "units", "triangles_read", "zero_area_dropped", "triangles" (of
 /// positive area), "distinct_normals", "hull_facets", "great_circle", "normal": [x, y, z],
