@@ -229,11 +229,15 @@ void printTrimmedSummary(const std::string& source, const OptimalSlicing& result
           : fmt::format("alpha* >= {:.4f} deg ({})", toDegrees(result.alphaRad), certificateSummary(result, certify));
   std::string upper = "no upper bound (no piece lies wholly inside a face)";
   if (facts.inside != nullptr) {
-    upper = facts.inside->method == "covered"
-                ? std::string("alpha* = 0: the normals inside the faces alone cover the sphere (proven): no slicing "
-                              "direction exists")
-                : fmt::format("<= {:.4f} deg (the optimum of the pieces inside the faces)",
-                              toDegrees(facts.inside->alphaRad));
+    if (facts.inside->method == "covered") {
+      upper = "alpha* = 0: the normals inside the faces alone cover the sphere (proven): no slicing direction exists";
+    } else if (facts.inside->method == "lattice") {
+      upper = fmt::format("no upper bound: the pieces inside the faces leave no direction free within the Gauss "
+                          "map's tolerance, unproven (the best found: {:.4f} deg)",
+                          toDegrees(facts.inside->alphaRad));
+    } else {
+      upper = fmt::format("<= {:.4f} deg (the optimum of the pieces inside the faces)", toDegrees(facts.inside->alphaRad));
+    }
   }
   fmt::print(stderr,
              "scallop: {}: {} trimmed faces followed by {} pieces inside and {} on their trimming curves (normals "

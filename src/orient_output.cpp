@@ -961,10 +961,12 @@ std::string trimmedOrientationToJson(const OptimalSlicing& result, double tolera
   trimmed["alpha_lower_deg"] = toDegrees(result.certified ? result.certifiedAlphaRad : result.alphaRad);
   if (facts.inside != nullptr) {
     trimmed["alpha_upper_deg"] = toDegrees(facts.inside->alphaRad);
+    trimmed["upper_method"] = facts.inside->method;
     trimmed["upper_normal"] = {facts.inside->normal.x, facts.inside->normal.y, facts.inside->normal.z};
     trimmed["seconds"] = facts.inside->seconds;
   } else {
     trimmed["alpha_upper_deg"] = nullptr;
+    trimmed["upper_method"] = nullptr;
     trimmed["upper_normal"] = nullptr;
     trimmed["seconds"] = 0.0;
   }

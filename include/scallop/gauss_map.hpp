@@ -101,7 +101,11 @@
 //         delta of them.
 // Cost:   O(cells + boundary samples), then the union (Clipper's sweeps over the sheets'
 //         loops, one per sheet for its nonzero region, one for the complement, one for the
-//         shrinking; some five times faster than Boost.Polygon's at 100,000 segments): the
+//         shrinking; some five times faster than Boost.Polygon's at 100,000 segments; past
+//         512 pieces, as with thousands of patches, the pieces are united in groups of 16, a
+//         tree of unions, before the complement: one sweep over all of them grows with the
+//         square of the loops a scanbeam crosses, 244 s for 400 translated copies of paper-1's
+//         patch where the tree takes 0.9 s, and 2,000 copies 4.6 s): the
 //         boundary samples grow as delta^-1/2 (chords within delta of curves), so
 //         ~100,000 boundary segments need delta ~4e-7 degree. On the paper's bicubic surfaces
 //         the quadtree stops at some 40 to 90 cells whatever delta is (34 to 48 of them

@@ -60,9 +60,9 @@ using CellClassifier = std::function<CellPlace(const ParameterCell&)>;
 
 struct TrimSplitOptions {
   /// Boundary cells are split until their normals spread by at most this (radians, > 0).
-  /// The pieces grow as 1 / spread along the trimming curves, and the Gauss map's union more
-  /// than linearly with the pieces (measured on OCCT's screw.step: 404 pieces at 4 degrees,
-  /// 0.9 s; 938 at 2, 2.3 s; 2,002 at 1, 7.8 s; 4,152 at 0.5, 40 s).
+  /// The pieces grow as 1 / spread along the trimming curves (measured on OCCT's screw.step,
+  /// `scallop orient` in all: 938 pieces at 2 degrees, 1.8 s; 4,152 at 0.5, 7.4 s; 8,576 at
+  /// 0.25, 15 s).
   double normalSpreadRad = 2.0 * std::numbers::pi / 180.0;
   /// Deepest quadtree level, 1 .. 20 (cells of 2^-depth in u and v).
   int maxDepth = 14;
