@@ -18,7 +18,7 @@ namespace {
 
 using Piece = std::vector<SectionPoint>;
 
-// f(u, v) = n . r(u, v) - d on one patch, with its partial derivatives and the roots of f
+// f(u, v) = n . r(u, v) - d on one patch (times w on a rational patch), with its partial derivatives and the roots of f
 // along every iso-parameter line a cell edge lies on. The roots are computed once per line
 // (not per cell), so the two cells that share an edge see the same crossings bit for bit,
 // and the pieces traced in them meet exactly.
@@ -29,7 +29,10 @@ class PatchSection {
     f_.degreeU = patch.degreeU;
     f_.degreeV = patch.degreeV;
     f_.coefficients.reserve(patch.control.size());
-    for (const Vec3& p : patch.control) f_.coefficients.push_back(dot(n, p) - d);
+    // A rational patch: f w = n . X - d w (X = w r, bezier.hpp's homogeneous coordinates) is
+    // a polynomial with coefficients w_jk (n . p_jk - d), and has f's zeros and signs (w > 0).
+    for (std::size_t i = 0; i < patch.control.size(); ++i)
+      f_.coefficients.push_back((patch.rational() ? patch.weights[i] : 1.0) * (dot(n, patch.control[i]) - d));
     fu_ = derivativeU(f_);
     fv_ = derivativeV(f_);
   }
@@ -402,7 +405,6 @@ void joinPieces(std::vector<Piece> pieces, double joinTolerance, PlaneSection& o
 
 PlaneSection planeSection(const Surface& surface, const Vec3& normal, double offset,
                           double chordalTolerance) {
-  requirePolynomial(surface, "plane sections");
   const double length = norm(normal);
   if (!std::isfinite(length) || length == 0.0)
     throw Error(fmt::format("plane section: the plane normal ({}, {}, {}) must be finite and non-zero",

@@ -19,6 +19,7 @@
 #include "scallop/error.hpp"
 #include "scallop/section.hpp"
 #include "scallop/surface.hpp"
+#include "rational_patches.hpp"
 
 namespace {
 
@@ -286,6 +287,50 @@ TEST(Section, AgreesWithMarchingSquares) {
     }
   }
   EXPECT_EQ(cases, 42);
+}
+
+// Rational patches (bezier.hpp): random bumpy ones against marching squares (which evaluates
+// the rational points), and torus patches against the closed form: z = c cuts the outer quarter
+// in a quarter circle of radius a + sqrt(b^2 - c^2).
+TEST(Section, RationalPatchesAgreeWithMarchingSquaresAndTheTorus) {
+  std::mt19937_64 rng(20261128);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int cases = 0;
+  for (int i = 0; i < 6; ++i) {
+    const Surface s{scallop::Units::inch, {scallop::test::randomRationalPatch(rng, 1 + i % 3, 2 + i % 2)}};
+    for (int trial = 0; trial < 4; ++trial) {
+      const double theta = std::acos(2 * unit(rng) - 1), phi = 2 * std::numbers::pi * unit(rng);
+      const Vec3 n{std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)};
+      const double d = scallop::dot(n, scallop::point(s.patches[0], unit(rng), unit(rng)));
+      const double tolerance = 1e-4;
+      const PlaneSection ours = scallop::planeSection(s, n, d, tolerance);
+      const Marching reference = marchingSquares(s, n, d, 400);
+      for (const auto& c : ours.curves)
+        for (const auto& p : c.points) {
+          EXPECT_NEAR(scallop::dot(n, p.point), d, 1e-12);
+          EXPECT_LE(scallop::norm(p.point - scallop::point(s.patches[0], p.u, p.v)), 1e-14);
+        }
+      double worst = 0.0;
+      for (const Vec3& x : reference.crossings) worst = std::max(worst, distanceToSection(x, ours));
+      EXPECT_LT(worst, 2 * tolerance) << "patch " << i << " trial " << trial;
+      EXPECT_NEAR(totalLength(ours), reference.length, 2e-3 * reference.length + 1e-9);
+      EXPECT_EQ(ours.components, reference.components) << "patch " << i << " trial " << trial;
+      ++cases;
+    }
+  }
+  EXPECT_EQ(cases, 24);
+  const double a = 3.0, b = 1.0;
+  const Surface torus{scallop::Units::inch, {scallop::test::torusPatch(a, b, true)}};
+  for (const double c : {0.1, 0.5, 0.9}) {
+    const PlaneSection ours = scallop::planeSection(torus, {0, 0, 1}, c, 1e-6);
+    ASSERT_EQ(ours.curves.size(), 1u) << c;
+    const double radius = a + std::sqrt(b * b - c * c);
+    for (const auto& p : ours.curves[0].points) EXPECT_NEAR(std::hypot(p.point.x, p.point.y), radius, 1e-12);
+    // The polyline is inscribed: shorter than the arc by at most its chords' sag.
+    const double arc = 0.5 * std::numbers::pi * radius;
+    EXPECT_LE(totalLength(ours), arc + 1e-12) << c;
+    EXPECT_GE(totalLength(ours), arc * (1.0 - 1e-5)) << c;
+  }
 }
 
 TEST(Section, SplitSurfaceGivesTheSameSection) {

@@ -67,7 +67,8 @@
 //         max|w_{j+1,k} - w_jk| max|p_jk|) / min w (a bound on |r_u| by the quotient rule),
 //         likewise S_v, and the factor (6(m + n) + 16) u. coordinatePolynomials is for
 //         polynomial patches (scallop::Error on a rational one): the modules built on it
-//         (sections, distances, the design heights) take polynomial patches only, and
+//         (distances, the design heights) take polynomial patches only (plane sections work
+//         on homogeneousPolynomials' X and w, and take rational ones), and
 //         surface.hpp's validateSurface refuses rational patches unless asked to accept them.
 
 #include <array>

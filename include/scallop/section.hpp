@@ -19,7 +19,9 @@
 //         pieces (a junction where several branches meet, as at a saddle tangent to the plane,
 //         is one component).
 // Method (why it is robust where the plane is tangent): f(u, v) = N . r(u, v) - d is a
-//         tensor Bernstein polynomial of the patch's bidegree, with coefficients N . p_jk - d.
+//         tensor Bernstein polynomial of the patch's bidegree, with coefficients N . p_jk - d
+//         (on a rational patch, w f = N . X - d w with coefficients w_jk (N . p_jk - d): the
+//         same zeros and signs, as w > 0; its points are r = X / w).
 //         A quadtree on [0, 1]^2 drops a cell when f's coefficients there are all >= 0 or all
 //         <= 0 (then f has no zero inside the open cell; zeros on its edges belong to the
 //         neighbours, and patch boundary edges lying in the plane are added whole), and

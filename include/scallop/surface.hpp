@@ -37,8 +37,9 @@
 // kMaxWeightRatio times the least; its regularity is decided as a polynomial patch's, on
 // N = w^3 r_u x r_v (bezier.hpp), its weights scaled by a power of two to a largest in
 // [0.5, 1). Rational patches are taken by the Gauss map and the optimal slicing (`scallop
-// orient`); the computations built on coordinate polynomials (sections, distances, tool
-// paths, the simulated cut) refuse them by name (requirePolynomial).
+// orient`) and by plane sections (section.hpp); the computations built on coordinate
+// polynomials (distances, tool paths, the simulated cut) refuse them by name
+// (requirePolynomial).
 // Degree 0 in a direction is rejected: r_u or r_v would vanish identically. (Accepted
 // patches also satisfy |r_u x r_v| > 1e-12 S_u S_v, above the threshold where bezier.hpp's
 // unitNormal throws, so unitNormal never throws on them.)
@@ -151,7 +152,7 @@ std::string surfaceToJson(const Surface& surface);
 void validateSurface(const Surface& surface);
 
 /// scallop::Error naming `what` and the first rational patch, if any: for the computations
-/// that take polynomial patches only (sections, distances, tool paths, the simulated cut).
+/// that take polynomial patches only (distances, tool paths, the simulated cut).
 void requirePolynomial(const Surface& surface, std::string_view what);
 /// The same, the message prefixed with `sourceName` ("s.json: patches[i]...: ...").
 void validateSurface(const Surface& surface, const std::string& sourceName);
