@@ -132,7 +132,7 @@ void runPaths(const PathsOptions& options) {
   }
   if (!options.units.empty() || options.dropZeroArea)
     throw Error("--units and --drop-zero-area are for STL meshes (a .stl file); a surface's units are in its file");
-  const CadRoute route = cadRoute(options.surface, options.tessellate, options.deflection);
+  const CadRoute route = cadRoute(options.surface, options.tessellate, options.deflection, exactRationalFaces());
   if (route.tessellate) {
     MeshRasterRequest request = meshRequest(options);
     request.quiet = options.jsonPath.empty() && options.gcodePath.empty();  // JSON on stdout: stderr quiet too
@@ -160,11 +160,6 @@ void runPaths(const PathsOptions& options) {
 
   const Surface surface = loadSurface(options.surface, true, route.exact ? &*route.exact : nullptr);
   const std::string source = sourceName(options.surface);
-  try {
-    requirePolynomial(surface, "scallop paths");
-  } catch (const Error& error) {
-    throw Error(fmt::format("{}: {}", source, error.what()));
-  }
   const double rapidRate = options.rapidRate.empty()
                                ? defaultRapidRate(surface.units)
                                : parsePositive(options.rapidRate, "rapid rate", "a positive rate");

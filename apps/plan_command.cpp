@@ -296,7 +296,7 @@ void runPlan(const PlanOptions& options) {
   if (!options.units.empty() || options.dropZeroArea)
     throw Error("--units and --drop-zero-area are for STL meshes (a .stl file); a surface's units are in its file");
   // Every face exact: the surface route below. Otherwise (or asked) the tessellation.
-  const CadRoute route = cadRoute(options.surface, options.tessellate, options.deflection);
+  const CadRoute route = cadRoute(options.surface, options.tessellate, options.deflection, exactRationalFaces());
   if (route.tessellate) {
     rejectMeshOptions(options, "a tessellated part");
     MeshJob job = tessellatedJob(*route.part, route.exact, meshRequest(options), options.deflection);
@@ -307,11 +307,6 @@ void runPlan(const PlanOptions& options) {
   if (from.input.empty() && from.example.empty()) from.example = "paper-1";  // the main job
   const Surface surface = loadSurface(from, !options.quiet, route.exact ? &*route.exact : nullptr);
   const std::string source = sourceName(from);
-  try {
-    requirePolynomial(surface, "scallop plan");
-  } catch (const Error& error) {
-    throw Error(fmt::format("{}: {}", source, error.what()));
-  }
   const bool inch = surface.units == Units::inch;
   auto progress = [&](const std::string& line) {
     if (!options.quiet) fmt::print(stderr, "scallop plan: {}...\n", line);

@@ -160,6 +160,12 @@ CadRoute cadRoute(const SurfaceSource& source, bool tessellate, const std::strin
   return route;
 }
 
+CadImportOptions exactRationalFaces() {
+  CadImportOptions options;
+  options.acceptRational = true;
+  return options;
+}
+
 std::string sourceName(const SurfaceSource& source) {
   std::string name = sourceBaseName(source);
   if (!source.patches.empty()) name += fmt::format(" (patches {})", source.patches);

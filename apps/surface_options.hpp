@@ -26,7 +26,7 @@ struct SurfaceSource {
   std::string example;
   std::string patches;
   bool skipFaces = false;
-  bool acceptRational = false;  // STEP/IGES rational faces as rational patches (orient)
+  bool acceptRational = true;  // STEP/IGES rational faces as rational patches (every command takes them)
 };
 
 /// Adds the SURFACE positional and --example NAME (checked against the built-in names,
@@ -67,6 +67,11 @@ struct CadRoute {
 /// trimmed faces' pieces; the others neither).
 CadRoute cadRoute(const SurfaceSource& source, bool tessellate, const std::string& deflection,
                   const CadImportOptions& exactOptions = {});
+
+/// The exact route's options for plan, paths and verify: rational faces as rational patches
+/// (sections, distances and the simulated cut take them); trimmed faces refused (their tool
+/// paths would not stop at the trimming curves: the part goes through its tessellation).
+CadImportOptions exactRationalFaces();
 
 /// How messages and reports name the surface: "example NAME", "<stdin>" or the path, followed
 /// by " (patches LIST)" when some are selected.

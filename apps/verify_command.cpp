@@ -80,7 +80,7 @@ int runVerify(const VerifyOptions& options) {
   if (mesh) {
     stl = loadStlMesh(source.input, options.units, options.dropZeroArea);
   } else {
-    route = cadRoute(source, false, "");
+    route = cadRoute(source, false, "", exactRationalFaces());
     if (route->tessellate) {
       part = &*route->part;
       if (!options.patches.empty())
@@ -95,13 +95,6 @@ int runVerify(const VerifyOptions& options) {
                    source.input, route->exact->skipped.size(), part->faces(), route->exact->skipped.front().reason);
     } else {
       surface = loadSurface(source, true, route->exact ? &*route->exact : nullptr);
-    }
-  }
-  if (surface) {
-    try {
-      requirePolynomial(*surface, "scallop verify");
-    } catch (const Error& error) {
-      throw Error(fmt::format("{}: {}", sourceName(source), error.what()));
     }
   }
   const Units designUnits = mesh ? stl->mesh.units : part ? part->units() : surface->units;

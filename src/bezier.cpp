@@ -120,35 +120,10 @@ Vec3 partial(const BezierPatch& patch, double u, double v, int du, int dv) {
   return partialImpl<>(patch, u, v, du, dv);
 }
 
-// A rational patch's homogeneous nets as two polynomial patches: X = w p, and w in the x
-// coordinate (y = z = 0), so that partial() differences and evaluates them as any patch.
-std::pair<BezierPatch, BezierPatch> homogeneousNets(const BezierPatch& patch) {
-  BezierPatch x{patch.degreeU, patch.degreeV, patch.control, {}};
-  BezierPatch w{patch.degreeU, patch.degreeV, std::vector<Vec3>(patch.control.size()), {}};
-  for (std::size_t i = 0; i < patch.control.size(); ++i) {
-    x.control[i] = patch.weights[i] * patch.control[i];
-    w.control[i] = {patch.weights[i], 0.0, 0.0};
-  }
-  return {std::move(x), std::move(w)};
-}
 
 // r and its partials to second order of a rational patch by the quotient rule (see the
-// contract).
-PatchDerivatives rationalDerivatives(const BezierPatch& patch, double u, double v, Vec3* value) {
-  const auto [xNet, wNet] = homogeneousNets(patch);
-  const auto at = [&](const BezierPatch& net, int du, int dv) { return partial(net, u, v, du, dv); };
-  const double w = at(wNet, 0, 0).x, wu = at(wNet, 1, 0).x, wv = at(wNet, 0, 1).x;
-  const double wuu = at(wNet, 2, 0).x, wuv = at(wNet, 1, 1).x, wvv = at(wNet, 0, 2).x;
-  const Vec3 r = at(xNet, 0, 0) / w;
-  PatchDerivatives d{};
-  d.u = (at(xNet, 1, 0) - wu * r) / w;
-  d.v = (at(xNet, 0, 1) - wv * r) / w;
-  d.uu = (at(xNet, 2, 0) - 2.0 * wu * d.u - wuu * r) / w;
-  d.uv = (at(xNet, 1, 1) - wu * d.v - wv * d.u - wuv * r) / w;
-  d.vv = (at(xNet, 0, 2) - 2.0 * wv * d.v - wvv * r) / w;
-  if (value) *value = r;
-  return d;
-}
+// contract); defined below, beside derivativesToSecondOrder's sums.
+PatchDerivatives rationalDerivatives(const BezierPatch& patch, double u, double v, Vec3* value);
 
 // partial() of any patch: the polynomial's own, or the rational's by the quotient rule.
 Vec3 anyPartial(const BezierPatch& patch, double u, double v, int du, int dv) {
@@ -573,6 +548,71 @@ PatchDerivatives derivativesImpl(const BezierPatch& patch, double u, double v) {
     out.vv = out.vv + bu[j] * row2;
   }
   return out;
+}
+
+// The same sums over the homogeneous net (X_jk = w_jk p_jk and w_jk) in one pass, then the
+// quotient rule: r = X / w, r_u = (X_u - w_u r) / w, r_uu = (X_uu - 2 w_u r_u - w_uu r) / w,
+// r_uv = (X_uv - w_u r_v - w_v r_u - w_uv r) / w, and likewise in v.
+template <int M = -1, int N = -1>
+PatchDerivatives rationalImpl(const BezierPatch& patch, double u, double v, Vec3* value) {
+  const int m = M >= 0 ? M : patch.degreeU;
+  const int n = N >= 0 ? N : patch.degreeV;
+  constexpr int kSmall = 16;
+  const bool onStack = std::max(m, n) < kSmall;
+  const int su = onStack ? kSmall : m + 1;
+  const int sv = onStack ? kSmall : n + 1;
+  std::array<double, 6 * kSmall> small;
+  std::vector<double> large;
+  double* bu = small.data();
+  if (!onStack) {
+    large.resize(3 * static_cast<std::size_t>(su + sv));
+    bu = large.data();
+  }
+  double* bv = bu + 3 * su;
+  basisDerivatives<M>(m, u, bu, bu + su, bu + 2 * su);
+  basisDerivatives<N>(n, v, bv, bv + sv, bv + 2 * sv);
+  Vec3 x{}, xu{}, xv{}, xuu{}, xuv{}, xvv{};
+  double w = 0.0, wu = 0.0, wv = 0.0, wuu = 0.0, wuv = 0.0, wvv = 0.0;
+  for (int j = 0; j <= m; ++j) {
+    Vec3 row0{}, row1{}, row2{};
+    double weight0 = 0.0, weight1 = 0.0, weight2 = 0.0;
+    for (int k = 0; k <= n; ++k) {
+      const double wk = patch.weight(j, k);
+      const Vec3 p = wk * patch.at(j, k);
+      row0 = row0 + bv[k] * p;
+      row1 = row1 + bv[sv + k] * p;
+      row2 = row2 + bv[2 * sv + k] * p;
+      weight0 += bv[k] * wk;
+      weight1 += bv[sv + k] * wk;
+      weight2 += bv[2 * sv + k] * wk;
+    }
+    x = x + bu[j] * row0;
+    xu = xu + bu[su + j] * row0;
+    xv = xv + bu[j] * row1;
+    xuu = xuu + bu[2 * su + j] * row0;
+    xuv = xuv + bu[su + j] * row1;
+    xvv = xvv + bu[j] * row2;
+    w += bu[j] * weight0;
+    wu += bu[su + j] * weight0;
+    wv += bu[j] * weight1;
+    wuu += bu[2 * su + j] * weight0;
+    wuv += bu[su + j] * weight1;
+    wvv += bu[j] * weight2;
+  }
+  const Vec3 r = x / w;
+  PatchDerivatives d{};
+  d.u = (xu - wu * r) / w;
+  d.v = (xv - wv * r) / w;
+  d.uu = (xuu - 2.0 * wu * d.u - wuu * r) / w;
+  d.uv = (xuv - wu * d.v - wv * d.u - wuv * r) / w;
+  d.vv = (xvv - 2.0 * wv * d.v - wvv * r) / w;
+  if (value) *value = r;
+  return d;
+}
+
+PatchDerivatives rationalDerivatives(const BezierPatch& patch, double u, double v, Vec3* value) {
+  if (patch.degreeU == 3 && patch.degreeV == 3) return rationalImpl<3, 3>(patch, u, v, value);
+  return rationalImpl<>(patch, u, v, value);
 }
 
 }  // namespace

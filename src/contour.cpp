@@ -130,7 +130,6 @@ PlaneRange planeRange(const Surface& surface, const Vec3& unitNormal, double spa
 }
 
 ContourPaths contourPaths(const Surface& surface, const ContourOptions& options) {
-  requirePolynomial(surface, "the contour strategy");
   validateSurface(surface);
   const double length = norm(options.normal);
   if (!std::isfinite(length) || length == 0.0)

@@ -362,7 +362,6 @@ CuspStatistics cuspStatistics(const Surface& surface, const Vec3& unitNormal,
 
 AdaptiveOffsets adaptivePlaneOffsets(const Surface& surface, const Vec3& unitNormal,
                                      const CuspOptions& options) {
-  requirePolynomial(surface, "adaptive plane spacing");
   validateSurface(surface);
   const double radius = options.toolRadius, height = options.scallopHeight;
   requirePositive("the tool radius", radius);

@@ -486,7 +486,6 @@ HeightGrid gridOver(const XyBox& box, const SimulationOptions& options) {
 }  // namespace
 
 HeightGrid simulationGrid(const Surface& surface, const SimulationOptions& options) {
-  requirePolynomial(surface, "the simulated cut");
   validateOptions(options);
   if (surface.patches.empty()) throw Error("the surface has no patches");
   XyBox box;
@@ -514,17 +513,33 @@ HeightGrid simulationGrid(Vec2 low, Vec2 high, const SimulationOptions& options)
   return gridOver(box, options);
 }
 
+// The sign of d(x, y) / d(u, v) as a polynomial: x_u y_v - x_v y_u itself on a polynomial
+// patch; on a rational one, with H = (X, Y, w) its homogeneous coordinates (x = X / w,
+// y = Y / w), the identity d(x, y) / d(u, v) = det(H, H_u, H_v) / w^3 gives the determinant,
+// expanded along H: X (Y_u w_v - w_u Y_v) - Y (X_u w_v - w_u X_v) + w (X_u Y_v - Y_u X_v),
+// bidegree (3m - 1, 3n - 1), of the same sign (w > 0).
+Bernstein2 jacobianSign(const BezierPatch& patch) {
+  if (!patch.rational()) {
+    const std::array<Bernstein2, 3> r = coordinatePolynomials(patch);
+    return subtract(multiply(derivativeU(r[0]), derivativeV(r[1])), multiply(derivativeV(r[0]), derivativeU(r[1])));
+  }
+  const std::array<Bernstein2, 4> h = homogeneousPolynomials(patch);
+  const Bernstein2 &x = h[0], &y = h[1], &w = h[3];
+  const Bernstein2 xu = derivativeU(x), xv = derivativeV(x), yu = derivativeU(y), yv = derivativeV(y);
+  const Bernstein2 wu = derivativeU(w), wv = derivativeV(w);
+  const auto minor = [](const Bernstein2& au, const Bernstein2& av, const Bernstein2& bu, const Bernstein2& bv) {
+    return subtract(multiply(au, bv), multiply(bu, av));  // a_u b_v - b_u a_v
+  };
+  return add(subtract(multiply(x, minor(yu, yv, wu, wv)), multiply(y, minor(xu, xv, wu, wv))),
+             multiply(w, minor(xu, xv, yu, yv)));
+}
+
 void designHeights(const Surface& surface, HeightGrid& grid, std::vector<double>* normalZ) {
-  requirePolynomial(surface, "the simulated cut");
   std::fill(grid.z.begin(), grid.z.end(), -kInf);
   if (normalZ) normalZ->assign(grid.z.size(), 0.0);
   const double tolerance = 1e-12 * std::max(surfaceScale(surface), 1e-300);
-  for (const BezierPatch& patch : surface.patches) {
-    const std::array<Bernstein2, 3> r = coordinatePolynomials(patch);
-    const Bernstein2 jacobian = subtract(multiply(derivativeU(r[0]), derivativeV(r[1])),
-                                         multiply(derivativeV(r[0]), derivativeU(r[1])));
-    designCell(DesignPatch{patch, jacobian, tolerance}, 0.0, 1.0, 0.0, 1.0, 0, grid, normalZ);
-  }
+  for (const BezierPatch& patch : surface.patches)
+    designCell(DesignPatch{patch, jacobianSign(patch), tolerance}, 0.0, 1.0, 0.0, 1.0, 0, grid, normalZ);
 }
 
 namespace {

@@ -37,10 +37,17 @@ struct Box {
 // One patch's sub-patches to `levels - 1` halvings in u and v. Level L holds 4^L cells; the
 // cell (iu, iv), on [iu, iu + 1] x [iv, iv + 1] / 2^L, is at index iu 2^L + iv, its control
 // net at nets[L][index * stride], its axis-aligned box at boxes[L][index].
+// A rational patch's net (bezier.hpp's rational patches) holds its (m + 1)(n + 1) Euclidean
+// control points p_jk, which bound the cell as a polynomial net does (the convex hull
+// property holds for positive weights), followed by its weights as (w_jk, 0, 0): halving works
+// on the homogeneous points w p and w, and divides back.
 struct PatchTree {
   int degreeU = 0;
   int degreeV = 0;
-  std::size_t stride = 0;  // (m + 1)(n + 1) control points per net
+  std::size_t points = 0;  // (m + 1)(n + 1) control points per net
+  std::size_t stride = 0;  // points, or 2 points for a rational patch (its weights after them)
+  bool rational = false;
+  double weightRatio = 1.0;  // a rational patch's largest weight over its least
   int levels = 0;
   std::vector<std::vector<Vec3>> nets;
   std::vector<std::vector<Box>> boxes;
@@ -250,6 +257,29 @@ void halveNet(const Vec3* net, int m, int n, Vec3* out) {
   }
 }
 
+// A tree's net halved into its four quarters (out: 4 strides): halveNet on a polynomial net;
+// on a rational one the homogeneous points w p and the weights are halved alike (de
+// Casteljau is linear) and each quarter's points divided back.
+void halveTreeNet(const PatchTree& tree, const Vec3* net, Vec3* out) {
+  if (!tree.rational) {
+    halveNet(net, tree.degreeU, tree.degreeV, out);
+    return;
+  }
+  const std::size_t count = tree.points;
+  std::vector<Vec3> homogeneous(count), weights(count), halvedPoints(4 * count), halvedWeights(4 * count);
+  for (std::size_t i = 0; i < count; ++i) {
+    homogeneous[i] = net[count + i].x * net[i];
+    weights[i] = net[count + i];
+  }
+  halveNet(homogeneous.data(), tree.degreeU, tree.degreeV, halvedPoints.data());
+  halveNet(weights.data(), tree.degreeU, tree.degreeV, halvedWeights.data());
+  for (std::size_t k = 0; k < 4; ++k)
+    for (std::size_t i = 0; i < count; ++i) {
+      out[k * tree.stride + i] = halvedPoints[k * count + i] / halvedWeights[k * count + i].x;
+      out[k * tree.stride + count + i] = halvedWeights[k * count + i];
+    }
+}
+
 // Value, first and second derivative of the degree-n curve b[0 .. n] at t (b is consumed):
 // de Casteljau down to three points q0, q1, q2; then r = the quadratic's value,
 // r' = n (e1 - e0) from the last level but one, r'' = n (n - 1) (q2 - 2 q1 + q0).
@@ -289,6 +319,10 @@ struct Jet {
   Vec3 r, ru, rv, ruu, ruv, rvv;
 };
 Jet jetAt(const BezierPatch& patch, double u, double v) {
+  if (patch.rational()) {  // the quotient rule (bezier.hpp)
+    const PatchDerivatives d = derivativesToSecondOrder(patch, u, v);
+    return {point(patch, u, v), d.u, d.v, d.uu, d.uv, d.vv};
+  }
   const int m = patch.degreeU;
   const int n = patch.degreeV;
   if (m == 3 && n == 3) {  // bicubic, unrolled
@@ -468,6 +502,9 @@ Box derivativeBox(const Vec3* net, int m, int n, int du, int dv) {
 // point, and points away from it for its neighbours), else the centre.
 double convexLowerBound(const Vec3* net, const BezierPatch& patch, std::size_t patchIndex,
                         double u0, double v0, double h, const Candidate& best, Vec3 p) {
+  // A rational cell's derivatives are quotients, not differences of its net: bounds 1 and 2
+  // carry its search alone (some more levels of cells near the foot point).
+  if (patch.rational()) return 0.0;
   const int m = patch.degreeU;
   const int n = patch.degreeV;
   const auto count = static_cast<std::size_t>((m + 1) * (n + 1));
@@ -596,14 +633,14 @@ struct CellStore {
       // Growing moves the nets: copy the parent first if it lives here.
       std::vector<Vec3> copy(parent, parent + stride);
       nets.resize(std::max(netsUsed, 2 * nets.size()));
-      halveNet(copy.data(), tree.degreeU, tree.degreeV, nets.data() + net);
+      halveTreeNet(tree, copy.data(), nets.data() + net);
     } else {
-      halveNet(parent, tree.degreeU, tree.degreeV, nets.data() + net);
+      halveTreeNet(tree, parent, nets.data() + net);
     }
     box = static_cast<std::uint32_t>(boxesUsed);
     boxesUsed += 4;
     if (boxesUsed > boxes.size()) boxes.resize(std::max(boxesUsed, 2 * boxes.size()));
-    for (std::size_t k = 0; k < 4; ++k) boxes[box + k] = boxOf(nets.data() + net + k * stride, stride);
+    for (std::size_t k = 0; k < 4; ++k) boxes[box + k] = boxOf(nets.data() + net + k * stride, tree.points);
     if (entries < kStoreSlots / 4) {
       slots[slot] = {iu, iv, patch, depth, net, box};
       ++entries;
@@ -617,7 +654,12 @@ struct CellStore {
 // its corners not seen before (`fresh`, a bit per corner), surface points, offered to
 // `consider`; and its axis-aligned box.
 double cellAllowance(const PatchTree& tree, int depth, double queryScale) {
-  return (3.0 * (tree.degreeU + tree.degreeV) * (depth + 1) + 16.0) * kUnitRoundoff * (tree.scale + queryScale);
+  // A rational net's points are quotients X / w of halved homogeneous points and weights:
+  // their errors, each of the polynomial net's order relative to w_max |p|_max and w_max,
+  // are divided by w >= w_min, so at most 2 w_max / w_min times the polynomial allowance.
+  const double quotient = tree.rational ? 2.0 * tree.weightRatio + 1.0 : 1.0;
+  return quotient * (3.0 * (tree.degreeU + tree.degreeV) * (depth + 1) + 16.0) * kUnitRoundoff *
+         (tree.scale + queryScale);
 }
 
 const Vec3* cellNet(const PatchTree& tree, const Cell& cell, const CellStore& store) {
@@ -709,6 +751,17 @@ void checkSurface(const Surface& surface) {
             fmt::format("surface distance: patches[{}]: control point {} is not finite", i, c));
       }
     }
+    if (patch.rational()) {
+      if (patch.weights.size() != expected)
+        throw Error(fmt::format("surface distance: patches[{}]: {} weights for {} control points", i,
+                                patch.weights.size(), expected));
+      for (std::size_t c = 0; c < patch.weights.size(); ++c)
+        if (!(patch.weights[c] > 0.0) || !std::isfinite(patch.weights[c]) ||
+            !(patch.weights[c] * kMaxWeightRatio >= *std::max_element(patch.weights.begin(), patch.weights.end())))
+          throw Error(fmt::format("surface distance: patches[{}]: weight {} is {}: weights must be positive, finite "
+                                  "and within a ratio of {:g}",
+                                  i, c, patch.weights[c], kMaxWeightRatio));
+    }
   }
 }
 
@@ -716,19 +769,26 @@ PatchTree buildTree(const BezierPatch& patch, int depth) {
   PatchTree tree;
   tree.degreeU = patch.degreeU;
   tree.degreeV = patch.degreeV;
-  tree.stride = patch.control.size();
+  tree.points = patch.control.size();
+  tree.rational = patch.rational();
+  tree.stride = tree.rational ? 2 * tree.points : tree.points;
   tree.levels = depth + 1;
   for (const Vec3& c : patch.control) tree.scale = std::max(tree.scale, maxAbs(c));
   tree.nets.resize(static_cast<std::size_t>(tree.levels));
   tree.boxes.resize(static_cast<std::size_t>(tree.levels));
   tree.nets[0] = patch.control;
+  if (tree.rational) {
+    const auto [least, largest] = std::minmax_element(patch.weights.begin(), patch.weights.end());
+    tree.weightRatio = *largest / *least;
+    for (const double w : patch.weights) tree.nets[0].push_back({w, 0.0, 0.0});
+  }
   for (int level = 0; level < tree.levels; ++level) {
     const auto side = std::size_t{1} << level;
     const auto L = static_cast<std::size_t>(level);
     std::vector<Box>& boxes = tree.boxes[L];
     boxes.resize(side * side);
     for (std::size_t i = 0; i < side * side; ++i) {
-      boxes[i] = boxOf(tree.nets[L].data() + i * tree.stride, tree.stride);
+      boxes[i] = boxOf(tree.nets[L].data() + i * tree.stride, tree.points);
     }
     if (level + 1 == tree.levels) break;
     std::vector<Vec3>& children = tree.nets[L + 1];
@@ -736,8 +796,7 @@ PatchTree buildTree(const BezierPatch& patch, int depth) {
     std::vector<Vec3> quarters(4 * tree.stride);
     for (std::size_t iu = 0; iu < side; ++iu) {
       for (std::size_t iv = 0; iv < side; ++iv) {
-        halveNet(tree.nets[L].data() + (iu * side + iv) * tree.stride, patch.degreeU, patch.degreeV,
-                 quarters.data());
+        halveTreeNet(tree, tree.nets[L].data() + (iu * side + iv) * tree.stride, quarters.data());
         for (std::size_t a = 0; a < 2; ++a) {
           for (std::size_t b = 0; b < 2; ++b) {
             const std::size_t child = (2 * iu + a) * (2 * side) + (2 * iv + b);
@@ -1115,7 +1174,6 @@ std::vector<Segment> segmentsOf(const ToolPath& path) {
 SurfaceDistance::SurfaceDistance(const Surface& surface, const DistanceOptions& options)
     : surface_(surface), options_(options) {
   checkSurface(surface_);
-  requirePolynomial(surface_, "the ball-to-surface distance");
   if (!(options.tolerance >= 0.0) || !std::isfinite(options.tolerance)) {
     throw Error(fmt::format("surface distance: the tolerance must be finite and >= 0, got {}",
                             options.tolerance));

@@ -443,7 +443,6 @@ std::pair<double, double> goldenMaximum(const F& f, double lo, double hi, double
 }  // namespace
 
 double bestRasterAngle(const Surface& surface) {
-  requirePolynomial(surface, "the raster strategy");
   validateSurface(surface);
   const AngleObjective objective(surface);
   // alpha is pi-periodic in a (e and -e make the same planes): scan [0, pi) and keep the
@@ -517,7 +516,6 @@ void liftRasterPaths(const SurfaceDistance& distance, const RasterOptions& optio
 }  // namespace
 
 RasterPaths rasterPaths(const Surface& surface, const RasterOptions& options) {
-  requirePolynomial(surface, "the raster strategy");
   validateSurface(surface);
   requirePositive("the tool radius", options.toolRadius);
   if (!options.bestAngle && !std::isfinite(options.angleRad))

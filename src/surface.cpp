@@ -898,15 +898,6 @@ void validateSurface(const Surface& surface, const std::string& sourceName) {
   }
 }
 
-void requirePolynomial(const Surface& surface, std::string_view what) {
-  for (std::size_t i = 0; i < surface.patches.size(); ++i)
-    if (surface.patches[i].rational())
-      throw Error(fmt::format("{} is rational, and {} is for polynomial patches only yet (scallop orient takes "
-                              "rational patches; plan and paths take a STEP or IGES part's rational faces through "
-                              "its tessellation)",
-                              patchPath(i), what));
-}
-
 void validateSurface(const Surface& surface) {
   if (surface.patches.empty()) throw Error("patches: no patches; a surface needs at least one");
   for (std::size_t i = 0; i < surface.patches.size(); ++i) validatePatch(surface.patches[i], i);

@@ -52,6 +52,8 @@
 #include "scallop/bezier.hpp"
 #include "scallop/cad_import.hpp"
 #include "scallop/error.hpp"
+#include "scallop/cut_simulation.hpp"
+#include "scallop/gcode_reader.hpp"
 #include "scallop/optimal_slicing.hpp"
 #include "scallop/surface.hpp"
 
@@ -524,11 +526,12 @@ TEST_F(CadCli, OrientAndPlanTakeAStepFile) {
   EXPECT_TRUE(fs::exists(workDir_ / "out" / "toolpath.ngc"));
 }
 
-// orient takes a rational face exactly (bezier.hpp's rational patches): a quarter of a
+// Every command takes a rational face exactly (bezier.hpp's rational patches): a part of a
 // cylinder's side (radius 2, axis z, 1 rad of it, 5 long) has horizontal normals only, on one
-// arc of the equator: alpha* = 90 deg at N* = z, certified. plan takes it through its
-// tessellation (rational patches are orient's only yet).
-TEST_F(CadCli, OrientTakesARationalFaceExactly) {
+// arc of the equator: alpha* = 90 deg at N* = z, certified; plan cuts it in horizontal
+// contours on the rational patch itself (no tessellation), judged by its simulated cut and
+// by `verify --fail-on-gouge`, and every ball centre stands R from the axis's cylinder.
+TEST_F(CadCli, EveryCommandTakesARationalFaceExactly) {
   const Handle(Geom_CylindricalSurface) cylinder = new Geom_CylindricalSurface(gp_Ax3(), 2.0);
   writeStep(BRepBuilderAPI_MakeFace(cylinder, 0.0, 1.0, 0.0, 5.0, Precision::Confusion()).Face(),
             workDir_ / "cylinder.step", "MM");
@@ -558,7 +561,24 @@ TEST_F(CadCli, OrientTakesARationalFaceExactly) {
   const scallop::test::RunResult plan = run("plan cylinder.step --tool-radius 0.5 --scallop-height 0.05 --out out --quiet");
   ASSERT_EQ(plan.exitCode, 0) << plan.err;
   const auto report = nlohmann::json::parse(scallop::test::readFile(workDir_ / "out" / "report.json"));
-  EXPECT_EQ(report["tessellation"]["design"], "exact faces");
+  EXPECT_FALSE(report.contains("tessellation"));
+  EXPECT_LE(report["verification"]["max_gouge"].get<double>(), report["verification"]["gouge_tolerance"].get<double>());
+  const scallop::test::RunResult verify =
+      run("verify cylinder.step out/toolpath.ngc --radius 0.5 --scallop-height 0.05 --fail-on-gouge");
+  EXPECT_EQ(verify.exitCode, 0) << verify.err;
+  // The wall faces +-x, +-y within its 1 rad arc; the cutting moves' ball centres beside it stand
+  // 2.5 from the axis (outside) to the G-code's 4 decimals, or above its top.
+  const scallop::GcodeProgram program = scallop::readGcodeProgram((workDir_ / "out" / "toolpath.ngc").string());
+  std::size_t beside = 0;
+  for (const scallop::SweptMove& move : scallop::sweptMoves(program, 0.5)) {
+    if (move.rapid) continue;
+    const Vec3 c = move.end;
+    const double angle = std::atan2(c.y, c.x);
+    if (c.z > 5.0 || angle < 0.0 || angle > 1.0) continue;
+    EXPECT_NEAR(std::hypot(c.x, c.y), 2.5, 1e-3) << c.x << ", " << c.y << ", " << c.z;
+    ++beside;
+  }
+  EXPECT_GT(beside, 100u);
 }
 
 TEST_F(CadCli, BadFilesFailCleanly) {
@@ -569,17 +589,17 @@ TEST_F(CadCli, BadFilesFailCleanly) {
   expectCleanFailure(run("plan garbage.igs --out out"), {"garbage.igs", "not an IGES file"}, "garbage.igs");
   fs::remove(workDir_ / "garbage.igs");
 
-  const Handle(Geom_CylindricalSurface) cylinder = new Geom_CylindricalSurface(gp_Ax3(), 2.0);
-  writeStep(BRepBuilderAPI_MakeFace(cylinder, 0.0, 1.0, 0.0, 5.0, Precision::Confusion()).Face(),
-            workDir_ / "cylinder.step", "MM");
-  // plan and paths take such a part through its tessellation (orient takes rational faces
-  // exactly); asked for the exact faces alone, none is left, and the message says why.
-  expectCleanFailure(run("paths cylinder.step --skip-faces --tool-radius 1 --scallop-height 0.01 --json out.json"),
-                     {"cylinder.step", "none of its 1 faces", "face 0", "rational"}, "cylinder.step");
-  expectCleanFailure(run("plan cylinder.step --skip-faces --out out"), {"cylinder.step", "none of its 1 faces"},
-                     "cylinder.step");
-  const std::string text = scallop::test::readFile(workDir_ / "cylinder.step");
-  fs::remove(workDir_ / "cylinder.step");
+  // A plane with a square hole: plan and paths take such a part through its tessellation;
+  // asked for the exact faces alone, none is left, and the message says why.
+  BRepBuilderAPI_MakeFace square(new Geom_Plane(gp_Ax3()), -5.0, 5.0, -5.0, 5.0, Precision::Confusion());
+  square.Add(BRepBuilderAPI_MakePolygon(gp_Pnt(-1, -1, 0), gp_Pnt(-1, 1, 0), gp_Pnt(1, 1, 0), gp_Pnt(1, -1, 0), true).Wire());
+  writeStep(square.Face(), workDir_ / "holed.step", "MM");
+  expectCleanFailure(run("paths holed.step --skip-faces --tool-radius 1 --scallop-height 0.01 --json out.json"),
+                     {"holed.step", "none of its 1 faces", "face 0", "trimmed"}, "holed.step");
+  expectCleanFailure(run("plan holed.step --skip-faces --out out"), {"holed.step", "none of its 1 faces"},
+                     "holed.step");
+  const std::string text = scallop::test::readFile(workDir_ / "holed.step");
+  fs::remove(workDir_ / "holed.step");
   write("cut.step", text.substr(0, text.size() - 40));
   expectCleanFailure(run("paths cut.step --tool-radius 1 --scallop-height 0.01 --json out.json"), {"cut.step", "truncated"},
                      "cut.step");

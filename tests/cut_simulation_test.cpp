@@ -27,6 +27,7 @@
 #include "scallop/raster.hpp"
 #include "scallop/surface.hpp"
 #include "scallop/verify_output.hpp"
+#include "rational_patches.hpp"
 
 namespace scallop {
 namespace {
@@ -488,6 +489,47 @@ TEST(DesignHeights, RandomGraphPatchesAgainstADenseMesh) {
     const Surface surface{Units::inch, {patch}};
     validateSurface(surface);
     expectDesignMatchesMesh(surface, 0.02, 2e-4, "trial " + std::to_string(trial));
+  }
+}
+
+// Rational patches (issue 14, item 2): random bumpy rational graphs against the dense mesh of
+// their rational points, and the torus's upper quarters against the closed form
+// z = sqrt(b^2 - (rho - a)^2), rho the distance from the axis, over their quarter annuli.
+TEST(DesignHeights, RationalPatchesAgainstADenseMeshAndTheTorus) {
+  std::mt19937_64 rng(1128);
+  for (int trial = 0; trial < 6; ++trial) {
+    const Surface surface{Units::inch, {scallop::test::randomRationalPatch(rng, 1 + trial % 3, 2 + trial % 2)}};
+    validateSurface(surface);
+    expectDesignMatchesMesh(surface, 0.02, 2e-4, "rational trial " + std::to_string(trial));
+  }
+  const double a = 3.0, b = 1.0;
+  for (const bool outer : {true, false}) {
+    const Surface surface{Units::inch, {scallop::test::torusPatch(a, b, outer)}};
+    // (Not against the mesh: at the rims the tube is vertical, where chords lag the surface.)
+    SimulationOptions options;
+    options.toolRadius = 0.25;
+    options.scallopHeight = 0.001;
+    options.resolution = 0.0137;
+    HeightGrid grid = simulationGrid(surface, options);
+    designHeights(surface, grid);
+    std::size_t checked = 0;
+    for (std::size_t j = 0; j < grid.rows; ++j)
+      for (std::size_t i = 0; i < grid.columns; ++i) {
+        const Vec2 p = grid.point(i, j);
+        const double rho = std::hypot(p.x, p.y), offset = rho - a;
+        const bool over = p.x > 1e-3 && p.y > 1e-3 && (outer ? offset > 1e-3 && offset < b - 1e-3
+                                                             : offset < -1e-3 && offset > -b + 1e-3);
+        const bool off = p.x < -1e-3 || p.y < -1e-3 || (outer ? offset < -1e-3 || offset > b + 1e-3
+                                                               : offset > 1e-3 || offset < -b - 1e-3);
+        const double z = grid.z[j * grid.columns + i];
+        if (over) {
+          ASSERT_NEAR(z, std::sqrt(b * b - offset * offset), 1e-9) << p.x << ", " << p.y;
+          ++checked;
+        } else if (off) {
+          ASSERT_EQ(z, -kInf) << p.x << ", " << p.y;
+        }
+      }
+    EXPECT_GT(checked, 1000u);
   }
 }
 

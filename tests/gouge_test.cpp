@@ -23,6 +23,7 @@
 #include "scallop/surface.hpp"
 #include "scallop/toolpath.hpp"
 #include "distance_reference.hpp"
+#include "rational_patches.hpp"
 
 namespace scallop {
 namespace {
@@ -179,6 +180,55 @@ TEST(SurfaceDistance, MatchesDenseSamplingOnRandomPatches) {
   // the grid (the search would then beat it, rightly). With these seeds it never does, so
   // the search is within the tolerance of it both ways on every query.
   EXPECT_EQ(referenceMissed, 0) << " of " << queries;
+}
+
+// Rational patches (bezier.hpp's; issue 14, item 2): random bumpy ones against the dense
+// sampling reference (which evaluates their rational points), and torus patches against the
+// closed form: a point t along the unit normal from a surface point, |t| below the tube's
+// radius b, is |t| from the torus, and the nearest point of the patch is that foot.
+TEST(SurfaceDistance, RationalPatchesMatchDenseSamplingAndTheTorus) {
+  std::mt19937_64 rng(1128);
+  int queries = 0;
+  int referenceMissed = 0;
+  for (int s = 0; s < 8; ++s) {
+    std::vector<BezierPatch> patches{scallop::test::randomRationalPatch(rng, 2 + s % 2, 3)};
+    if (s % 2 == 1) patches.push_back(scallop::test::torusPatch(3.0, 1.0, s % 4 == 1));
+    const Surface surface = surfaceOf(patches);
+    const SurfaceDistance engine(surface);
+    const std::vector<Vec3> points = queryPoints(rng, surface, 60);
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const std::string context = "rational surface " + std::to_string(s) + " point " + std::to_string(i);
+      if (checkAgainstReference(surface, engine, points[i], context)) {
+        // The search found a nearer surface point than the reference's basins held: a finer
+        // reference (160 x 160 samples, 24 starts) must find it too.
+        ++referenceMissed;
+        const double finer = referenceDistance(surface, points[i], 160, 24).refined;
+        EXPECT_NEAR(engine.closest(points[i]).distance, finer, engine.tolerance() + 1e-12) << context;
+      }
+      ++queries;
+    }
+  }
+  EXPECT_EQ(queries, 8 * 60);
+  EXPECT_LE(referenceMissed, 2) << " of " << queries;
+  std::uniform_real_distribution<double> unit(0.05, 0.95), along(-0.9, 0.9);
+  for (const bool outer : {true, false}) {
+    const BezierPatch torus = scallop::test::torusPatch(3.0, 1.0, outer);
+    const Surface surface = surfaceOf({torus});
+    const SurfaceDistance engine(surface);
+    for (int i = 0; i < 200; ++i) {
+      const double u = unit(rng), v = unit(rng), t = along(rng);
+      const Vec3 foot = point(torus, u, v);
+      const Vec3 p = foot + t * unitNormal(torus, u, v);
+      // On the torus itself: | |(rho - a, z)| - b | (rho the distance from the axis).
+      const double closedForm = std::abs(std::hypot(std::hypot(p.x, p.y) - 3.0, p.z) - 1.0);
+      ASSERT_NEAR(closedForm, std::abs(t), 1e-12);
+      const ClosestPoint result = engine.closest(p);
+      EXPECT_TRUE(result.converged);
+      EXPECT_NEAR(result.distance, std::abs(t), engine.tolerance() + 1e-12) << i;
+      EXPECT_LE(result.lowerBound, std::abs(t) + 1e-12) << i;
+      EXPECT_LE(norm(result.point - foot), 1e-4) << i;
+    }
+  }
 }
 
 // ---------------------------------------------------------------------------------------

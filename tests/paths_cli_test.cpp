@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -16,7 +17,11 @@
 
 #include "cli_fixture.hpp"
 #include "rs274.hpp"
+#include "distance_reference.hpp"
+#include "rational_patches.hpp"
 #include "scallop/bezier.hpp"
+#include "scallop/cut_simulation.hpp"
+#include "scallop/gcode_reader.hpp"
 #include "scallop/surface.hpp"
 
 namespace {
@@ -580,3 +585,53 @@ TEST_F(PlanAcceptance, Paper2InchBallWithoutRestFinishingLeavesMoreThanH) {
 // points beside the edges (the program's nearest ball stands 0.80 H from them); the rest
 // passes put a ball on each, and the reading is within H.
 TEST_F(PlanAcceptance, Paper2RasterSmallBall) { expectFinished("paper-2", "raster", 0.05); }
+
+// Rational patches through the exact route (issue 14, item 2): `scallop plan` on a surface JSON
+// of two random rational bumpy graphs (weights 0.3 .. 3), both strategies, judged by the
+// simulated cut (rational design heights, tested against closed forms in
+// cut_simulation_test.cpp), by `scallop verify --fail-on-gouge`, and by the dense-sampling
+// distance reference (distance_reference.hpp, scallop's rational points, no search of the
+// code under test) from 400 of the program's ball centres.
+TEST_F(PathsCli, PlanOnRationalPatchesIsGougeFreeAndFinishedToH) {
+  std::mt19937_64 rng(20261128);
+  scallop::Surface surface{scallop::Units::inch, {}};
+  for (int i = 0; i < 2; ++i) {
+    scallop::BezierPatch patch = scallop::test::randomRationalPatch(rng, 3, 3);
+    for (scallop::Vec3& c : patch.control) c = 2.0 * c + scallop::Vec3{2.0 * i, 0.0, 0.0};
+    surface.patches.push_back(patch);
+  }
+  scallop::validateSurface(surface);
+  write("rational.json", scallop::surfaceToJson(surface));
+  const double radius = 0.25, height = 0.002;
+  for (const std::string strategy : {"raster", "contour"}) {
+    SCOPED_TRACE(strategy);
+    const RunResult result = run(fmt::format("plan rational.json --quiet --strategy {} --tool-radius {} "
+                                             "--scallop-height {} --out out",
+                                             strategy, radius, height));
+    ASSERT_EQ(result.exitCode, 0) << result.err;
+    const auto report = nlohmann::json::parse(readFile(workDir_ / "out" / "report.json"));
+    const auto& v = report["verification"];
+    std::printf("[          ] rational %s: gouge %.3g, scallop max %.6f (H %.3f), above H %.5f in^2\n",
+                strategy.c_str(), v["max_gouge"].get<double>(), v["max_scallop"].get<double>(), height,
+                v["uncut_area"].get<double>());
+    EXPECT_LE(v["max_gouge"].get<double>(), v["gouge_tolerance"].get<double>());
+    EXPECT_LE(v["max_scallop"].get<double>(), height);
+    const RunResult verify = run(fmt::format("verify rational.json out/toolpath.ngc --radius {} --scallop-height {} "
+                                             "--fail-on-gouge",
+                                             radius, height));
+    EXPECT_EQ(verify.exitCode, 0) << verify.err;
+    const scallop::GcodeProgram program = scallop::readGcodeProgram((workDir_ / "out" / "toolpath.ngc").string());
+    const std::vector<scallop::SweptMove> moves = scallop::sweptMoves(program, radius);
+    std::size_t checked = 0;
+    double least = 1e9;
+    for (std::size_t i = 0; i < moves.size(); i += std::max<std::size_t>(1, moves.size() / 400)) {
+      if (moves[i].rapid) continue;
+      least = std::min(least, scallop::reference::referenceDistance(surface, moves[i].end).refined);
+      ++checked;
+    }
+    EXPECT_GT(checked, 300u);
+    // No deeper than the gouge tolerance (1e-4 in, the G-code's rounding) below R.
+    EXPECT_GE(least, radius - 1e-4) << strategy;
+    fs::remove_all(workDir_ / "out");
+  }
+}

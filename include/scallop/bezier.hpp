@@ -66,10 +66,9 @@
 //         The unit normal's rounding threshold takes S_u = (m max|X_{j+1,k} - X_jk| + m
 //         max|w_{j+1,k} - w_jk| max|p_jk|) / min w (a bound on |r_u| by the quotient rule),
 //         likewise S_v, and the factor (6(m + n) + 16) u. coordinatePolynomials is for
-//         polynomial patches (scallop::Error on a rational one): the modules built on it
-//         (distances, the design heights) take polynomial patches only (plane sections work
-//         on homogeneousPolynomials' X and w, and take rational ones), and
-//         surface.hpp's validateSurface refuses rational patches unless asked to accept them.
+//         polynomial patches (scallop::Error on a rational one): the modules that take
+//         rational patches work on homogeneousPolynomials' X and w instead (sections, the
+//         design heights), or on homogeneous nets (distances).
 
 #include <array>
 #include <utility>

@@ -111,8 +111,7 @@ struct CadImportOptions {
   /// not regular) instead of refusing the file; they are listed in CadImport::skipped.
   bool skipUnsupportedFaces = false;
   /// Rational faces become rational Bezier patches (bezier.hpp: poles and weights, exactly)
-  /// instead of being refused: for `scallop orient`, whose Gauss map takes them. The other
-  /// computations take polynomial patches only (surface.hpp's requirePolynomial).
+  /// instead of being refused (every command takes them: the CLI sets this).
   bool acceptRational = false;
   /// Trimmed faces (not a parameter rectangle of their surface) become pieces of their Bezier
   /// patches that follow the trimming curves (trimmed_patch.hpp) instead of being refused: for

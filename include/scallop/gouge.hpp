@@ -8,7 +8,8 @@
 // Contract: distance to the surface
 // ---------------------------------
 // Input:  a surface of Bezier patches (surface.hpp: degrees 1 .. kMaxPatchDegree, (m + 1)
-//         (n + 1) finite control points each; regularity is not needed here) and a finite
+//         (n + 1) finite control points each; regularity is not needed here; rational patches
+//         with positive weights within kMaxWeightRatio, see Rational below) and a finite
 //         point p, in the surface's units.
 // Output: the minimum of |r(u, v) - p| over every patch and (u, v) in [0, 1]^2, boundary
 //         included, as a point that attains the returned distance (patch, u, v, r(u, v)) and
@@ -48,6 +49,14 @@
 //         consecutive queries in one region (the drop envelope's proofs along a pass) reuse
 //         their nets and boxes instead of halving again. They are computed as the search
 //         would compute them, so every result is the same, bit for bit, whatever is kept.
+// Rational: a rational patch's cells keep their Euclidean control points (the cell lies in
+//         their convex hull, as the weights are positive) and weights; halving works on the
+//         homogeneous points w p and the weights, and divides back. Bounds 1 and 2 hold as
+//         for a polynomial net; bound 3 is not used (the derivatives are quotients, not
+//         differences of the net), so the search near a foot point takes a few more levels;
+//         the rounding allowance is multiplied by 2 w_max / w_min + 1 (the quotient's error,
+//         each part's relative to w_max, divided by w >= w_min). Points and derivatives by
+//         bezier.hpp's quotient rule.
 // Early exit: with a cutoff c, cells whose lower bound is >= c are dropped too (nothing
 //         below c there). Then either the result is converged as above, or lowerBound >= c
 //         (the true distance is at least c; `distance` is then the best point seen, perhaps

@@ -36,10 +36,9 @@
 // A rational patch's weights must be positive and finite, the largest at most
 // kMaxWeightRatio times the least; its regularity is decided as a polynomial patch's, on
 // N = w^3 r_u x r_v (bezier.hpp), its weights scaled by a power of two to a largest in
-// [0.5, 1). Rational patches are taken by the Gauss map and the optimal slicing (`scallop
-// orient`) and by plane sections (section.hpp); the computations built on coordinate
-// polynomials (distances, tool paths, the simulated cut) refuse them by name
-// (requirePolynomial).
+// [0.5, 1). Every computation takes rational patches: the Gauss map and the optimal slicing
+// on N's polynomials, plane sections on n . X - d w, distances on homogeneous nets, the
+// simulated cut's design heights on the homogeneous Jacobian (each module says how).
 // Degree 0 in a direction is rejected: r_u or r_v would vanish identically. (Accepted
 // patches also satisfy |r_u x r_v| > 1e-12 S_u S_v, above the threshold where bezier.hpp's
 // unitNormal throws, so unitNormal never throws on them.)
@@ -151,9 +150,6 @@ std::string surfaceToJson(const Surface& surface);
 /// Throws scallop::Error ("patches[i]...: ...") unless `surface` satisfies the contract.
 void validateSurface(const Surface& surface);
 
-/// scallop::Error naming `what` and the first rational patch, if any: for the computations
-/// that take polynomial patches only (distances, tool paths, the simulated cut).
-void requirePolynomial(const Surface& surface, std::string_view what);
 /// The same, the message prefixed with `sourceName` ("s.json: patches[i]...: ...").
 void validateSurface(const Surface& surface, const std::string& sourceName);
 
