@@ -95,6 +95,12 @@ struct FaceRefused {
   std::string reason;
 };
 
+// A trimmed face that needs more pieces than the budget allows: an error for the whole file
+// (not a face to skip), since the asked spread, not the face, is at fault.
+struct TrimBudgetExceeded {
+  std::string reason;
+};
+
 // --- faces -----------------------------------------------------------------------------------
 
 const char* surfaceKind(const Handle(Geom_Surface)& surface) {
@@ -749,15 +755,16 @@ FacePatches facePatches(const TopoDS_Face& face, Units units, Stage& stage, cons
       TrimSplitOptions split = options.trimSplit;
       split.maxPieces = std::min(split.maxPieces, trimBudget);
       if (split.maxPieces == 0)
-        throw Error(fmt::format("more than {} pieces in all follow the trimming curves of the part's faces",
-                                options.maxTrimPieces));
+        throw TrimBudgetExceeded{fmt::format("(piece {}): more than {} pieces in all follow the part's trimming "
+                                             "curves; a larger spread needs fewer",
+                                             index, options.maxTrimPieces)};
       TrimSplit pieceSplit;
       try {
         pieceSplit = splitTrimmedPatch(
             patches[index], [&](const ParameterCell& cell) { return classifyBox(face, arcs, parameters.box(cell)); },
             split);
       } catch (const Error& error) {
-        throw FaceRefused{CadFaceIssue::trimmed, fmt::format("(piece {}): {}", index, error.what())};
+        throw TrimBudgetExceeded{fmt::format("(piece {}): {}; a larger spread needs fewer", index, error.what())};
       }
       trimBudget -= pieceSplit.pieces.size();
       result.largestSpreadRad = std::max(result.largestSpreadRad, pieceSplit.largestSpreadRad);
@@ -834,6 +841,8 @@ CadImport convertFaces(const CadFile& transferred, const std::string& path, cons
       }
       if (patches.trimmed) ++result.trimmedFaces;
       result.largestSpreadRad = std::max(result.largestSpreadRad, patches.largestSpreadRad);
+    } catch (const TrimBudgetExceeded& exceeded) {
+      throw Error(fmt::format("{}: {} {}", path, detail::cadFaceName(transferred, face, index), exceeded.reason));
     } catch (const FaceRefused& refused) {
       const std::string name = detail::cadFaceName(transferred, face, index);
       if (!options.skipUnsupportedFaces) throw Error(fmt::format("{}: {} {}", path, name, refused.reason));

@@ -476,6 +476,15 @@ TEST(CadTrimmedSamples, ScrewStepsCertifiedDirectionClearsEveryNormalOcctSamples
               sampledCap * 180.0 / M_PI);
   EXPECT_GE(clearance, lower.certifiedAlphaRad - 1e-9);
   EXPECT_LE(lower.certifiedAlphaRad, sampledCap + 1e-9);
+  // A spread no budget can follow is an error naming the face, not a face skipped.
+  options.trimSplit.normalSpreadRad = 1e-9;
+  try {
+    (void)part.exactFaces(options);
+    ADD_FAILURE() << "no error past the budget of pieces";
+  } catch (const scallop::Error& error) {
+    scallop::test::expectMessageContains(error.what(), {"screw.step", "face 3", "more than 20000 pieces", "spread"},
+                                         "budget");
+  }
 }
 
 // --- exact heights ----------------------------------------------------------------------------
