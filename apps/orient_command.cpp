@@ -221,8 +221,8 @@ void printTrimmedSummary(const std::string& source, const OptimalSlicing& result
   std::string written;
   for (const OutputFile& output : outputs) written += (written.empty() ? "" : ", ") + output.path;
   const std::string lower =
-      result.method == "covered"
-          ? std::string("alpha* >= 0 (the pieces' normals, boundary pieces included, cover the sphere)")
+      result.method == "open"
+          ? std::string("alpha* >= 0 (the pieces, boundary pieces included, leave no direction free)")
       : certify && result.certified
           ? fmt::format("alpha* >= {:.4f} deg (certified over the faces and their boundary pieces)",
                         toDegrees(result.certifiedAlphaRad))
@@ -231,10 +231,9 @@ void printTrimmedSummary(const std::string& source, const OptimalSlicing& result
   if (facts.inside != nullptr) {
     if (facts.inside->method == "covered") {
       upper = "alpha* = 0: the normals inside the faces alone cover the sphere (proven): no slicing direction exists";
-    } else if (facts.inside->method == "lattice") {
-      upper = fmt::format("no upper bound: the pieces inside the faces leave no direction free within the Gauss "
-                          "map's tolerance, unproven (the best found: {:.4f} deg)",
-                          toDegrees(facts.inside->alphaRad));
+    } else if (facts.inside->method == "open" || facts.inside->method == "lattice") {
+      upper = "no upper bound: the pieces inside the faces leave no direction free within the Gauss map's tolerance, "
+              "unproven";
     } else {
       upper = fmt::format("<= {:.4f} deg (the optimum of the pieces inside the faces)", toDegrees(facts.inside->alphaRad));
     }
@@ -288,7 +287,12 @@ void runOrient(const OrientOptions& options) {
     throw Error(fmt::format("{}: --patches selects patches, and its trimmed faces are pieces: not with --patches",
                             options.surface.input));
   const Surface surface = loadSurface(source, true, route.exact ? &*route.exact : nullptr);
-  const OptimalSlicing result = optimalSlicing(surface, slicingOptions);
+  // A trimmed part's pieces hold more normals than its faces: when they leave no direction
+  // free, a proof that they cover the sphere says nothing of the faces, and alpha >= 0 is all
+  // the lower bound can say (the search over thousands of pieces would be long for it).
+  OptimalSlicingOptions allOptions = slicingOptions;
+  if (trimmed) allOptions.noComplement = OptimalSlicingOptions::NoComplement::stop;
+  const OptimalSlicing result = optimalSlicing(surface, allOptions);
   // A trimmed part: the pieces inside their faces alone bound alpha* from above (their normals
   // are the part's), as the slicing of all of them bounds it from below.
   std::optional<OptimalSlicing> inside;
@@ -306,6 +310,9 @@ void runOrient(const OrientOptions& options) {
     if (!insidePieces.patches.empty()) {
       OptimalSlicingOptions upperOptions = slicingOptions;
       upperOptions.certify = false;  // it bounds alpha* from above: a lower bound of its own says nothing
+      // No complement: a proof that these normals cover the sphere proves alpha* = 0; the
+      // lattice's best would bound nothing from above.
+      upperOptions.noComplement = OptimalSlicingOptions::NoComplement::prove;
       inside = optimalSlicing(insidePieces, upperOptions);
       facts.inside = &*inside;
     }

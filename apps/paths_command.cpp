@@ -241,7 +241,7 @@ void addPathsCommand(CLI::App& app) {
   addStlOptions(*paths, options->units, options->dropZeroArea);
   paths->add_flag("--tessellate", options->tessellate,
                   "STEP/IGES: raster on the part's tessellation, the proofs kept 1.5 times the measured deviation "
-                  "farther (parts with trimmed or rational faces are cut so without it)");
+                  "farther (parts with trimmed faces are cut so without it)");
   paths->add_option("--deflection", options->deflection, "STEP/IGES tessellation: OCCT mesher's linear deflection (default H/8)")
       ->type_name("D");
   paths->add_flag("--no-gouge-check", options->noGougeCheck, "skip the sampled ball-against-surface check (the drop envelope's proof stays)");

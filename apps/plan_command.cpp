@@ -481,7 +481,7 @@ void addPlanCommand(CLI::App& app) {
   plan->add_flag("--tessellate", options->tessellate,
                  "STEP/IGES: cut the part through its tessellation (raster on the mesh, proofs kept 1.5 times the "
                  "measured deviation farther, the cut simulated on the exact faces) even when every face could be "
-                 "imported exactly; parts with trimmed or rational faces are cut so without it");
+                 "imported exactly; parts with trimmed faces are cut so without it");
   plan->add_option("--deflection", options->deflection,
                    "STEP/IGES tessellation: OCCT mesher's linear deflection (default H/8)")
       ->type_name("D");

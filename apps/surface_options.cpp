@@ -75,7 +75,7 @@ Surface importCadSurface(const SurfaceSource& source, CadFormat format, bool ann
 
 void addSkipFacesOption(CLI::App& command, SurfaceSource& source) {
   command.add_flag("--skip-faces", source.skipFaces,
-                   "STEP/IGES: leave out the faces that cannot be imported exactly (rational, trimmed, "
+                   "STEP/IGES: leave out the faces that cannot be imported exactly (trimmed, "
                    "other kinds) instead of failing; they are counted on stderr");
 }
 

@@ -72,7 +72,7 @@ int runVerify(const VerifyOptions& options) {
     throw Error("--units and --drop-zero-area are for STL meshes (a .stl file); a surface's units are in its file");
   std::optional<StlMesh> stl;
   std::optional<Surface> surface;
-  // A STEP or IGES part with faces the exact importer refuses (trimmed, rational) is judged
+  // A STEP or IGES part with faces the exact importer refuses (trimmed faces) is judged
   // on its exact faces through OCCT (cad_tessellation.hpp), unless --skip-faces asks for the
   // exact faces alone.
   std::optional<CadRoute> route;

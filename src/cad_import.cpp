@@ -95,8 +95,8 @@ struct FaceRefused {
   std::string reason;
 };
 
-// A trimmed face that needs more pieces than the budget allows: an error for the whole file
-// (not a face to skip), since the asked spread, not the face, is at fault.
+// A trimmed face that needs more pieces than the budget allows: an error naming the face, or
+// with skipUnsupportedFaces a face skipped (the part then goes through its tessellation).
 struct TrimBudgetExceeded {
   std::string reason;
 };
@@ -727,14 +727,19 @@ FacePatches facePatches(const TopoDS_Face& face, Units units, Stage& stage, cons
         }
       patches.push_back(std::move(patch));
     }
-  try {
-    validateSurface(Surface{units, patches});
-  } catch (const Error& error) {
-    std::string message = error.what();
-    if (message.starts_with("patches[")) message = "piece " + message.substr(8);  // "patches[i]..." of this face
-    throw FaceRefused{CadFaceIssue::invalidPatch, fmt::format("has an invalid Bezier {} ({}, {} pieces)", message,
-                                                              surfaceKind(basis), patches.size())};
-  }
+  // A trimmed face's patches need be regular only where the face is: its pieces are checked
+  // after the split (a B-spline may be singular at a corner its trimming curves cut away).
+  const auto validate = [&](const std::vector<BezierPatch>& checked, const std::string& what) {
+    try {
+      validateSurface(Surface{units, checked});
+    } catch (const Error& error) {
+      std::string message = error.what();
+      if (message.starts_with("patches[")) message = what + " " + message.substr(8);  // "patches[i]..." of this face
+      throw FaceRefused{CadFaceIssue::invalidPatch, fmt::format("has an invalid Bezier {} ({}, {} {}s)", message,
+                                                                surfaceKind(basis), checked.size(), what)};
+    }
+  };
+  if (!result.trimmed) validate(patches, "piece");
   if (!result.trimmed) {
     result.roles.assign(patches.size(), PieceRole::inside);
     result.patches = std::move(patches);
@@ -752,21 +757,27 @@ FacePatches facePatches(const TopoDS_Face& face, Units units, Stage& stage, cons
     for (int j = 1; j <= pieces.UpperCol(); ++j, ++index) {
       PieceParameters parameters(basis, spline, converted, rectangle, knotsU(i), knotsU(i + 1), knotsV(j),
                                  knotsV(j + 1), reversed);
+      // A rational piece weighs more (see CadImportOptions::maxTrimPieces).
+      const std::size_t weight = patches[index].rational() ? kRationalPieceWeight : 1;
       TrimSplitOptions split = options.trimSplit;
-      split.maxPieces = std::min(split.maxPieces, trimBudget);
+      split.maxPieces = std::min(split.maxPieces, trimBudget / weight);
       if (split.maxPieces == 0)
-        throw TrimBudgetExceeded{fmt::format("(piece {}): more than {} pieces in all follow the part's trimming "
-                                             "curves; a larger spread needs fewer",
-                                             index, options.maxTrimPieces)};
+        throw TrimBudgetExceeded{fmt::format("(piece {}): more than {} pieces in all (a rational piece counts {}) "
+                                             "follow the part's trimming curves; a larger spread needs fewer",
+                                             index, options.maxTrimPieces, kRationalPieceWeight)};
       TrimSplit pieceSplit;
       try {
         pieceSplit = splitTrimmedPatch(
             patches[index], [&](const ParameterCell& cell) { return classifyBox(face, arcs, parameters.box(cell)); },
             split);
       } catch (const Error& error) {
+        if (split.maxPieces < options.trimSplit.maxPieces)  // the file's budget ran out, not the patch's
+          throw TrimBudgetExceeded{fmt::format("(piece {}): more than {} pieces in all (a rational piece counts {}) "
+                                               "follow the part's trimming curves; a larger spread needs fewer",
+                                               index, options.maxTrimPieces, kRationalPieceWeight)};
         throw TrimBudgetExceeded{fmt::format("(piece {}): {}; a larger spread needs fewer", index, error.what())};
       }
-      trimBudget -= pieceSplit.pieces.size();
+      trimBudget -= std::min(trimBudget, weight * pieceSplit.pieces.size());
       result.largestSpreadRad = std::max(result.largestSpreadRad, pieceSplit.largestSpreadRad);
       for (TrimmedPiece& piece : pieceSplit.pieces) {
         result.patches.push_back(std::move(piece.patch));
@@ -775,6 +786,7 @@ FacePatches facePatches(const TopoDS_Face& face, Units units, Stage& stage, cons
     }
   if (result.patches.empty())
     throw FaceRefused{CadFaceIssue::trimmed, "lies outside its own trimming curves (no piece of it is inside)"};
+  validate(result.patches, "trimmed piece");
   return result;
 }
 
@@ -842,7 +854,9 @@ CadImport convertFaces(const CadFile& transferred, const std::string& path, cons
       if (patches.trimmed) ++result.trimmedFaces;
       result.largestSpreadRad = std::max(result.largestSpreadRad, patches.largestSpreadRad);
     } catch (const TrimBudgetExceeded& exceeded) {
-      throw Error(fmt::format("{}: {} {}", path, detail::cadFaceName(transferred, face, index), exceeded.reason));
+      const std::string name = detail::cadFaceName(transferred, face, index);
+      if (!options.skipUnsupportedFaces) throw Error(fmt::format("{}: {} {}", path, name, exceeded.reason));
+      result.skipped.push_back({index, CadFaceIssue::trimmed, fmt::format("{} {}", name, exceeded.reason)});
     } catch (const FaceRefused& refused) {
       const std::string name = detail::cadFaceName(transferred, face, index);
       if (!options.skipUnsupportedFaces) throw Error(fmt::format("{}: {} {}", path, name, refused.reason));

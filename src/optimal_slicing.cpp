@@ -1453,7 +1453,19 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
     // No complement within the map's tolerance. "No direction exists" only with a proof
     // that the normals cover the sphere (normal_coverage.hpp); otherwise the best direction
     // that the lattice's seeds polish to, certified below like any other.
-    result.coverage = proveNormalsCoverSphere(surface);
+    using NoComplement = OptimalSlicingOptions::NoComplement;
+    if (options.noComplement != NoComplement::stop) result.coverage = proveNormalsCoverSphere(surface);
+    if (!result.coverage.proven && options.noComplement != NoComplement::proveThenSearch) {
+      // Asked not to search: alpha >= 0 holds at every direction, and nothing more is said.
+      result.method = "open";
+      result.normal = map.pole;
+      result.alphaRad = 0.0;
+      result.sphereCircle = {result.normal, 0.0};
+      result.certified = true;
+      result.certifiedAlphaRad = 0.0;
+      result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      return result;
+    }
     if (result.coverage.proven) {
       result.method = "covered";
       result.normal = map.pole;

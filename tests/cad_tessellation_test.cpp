@@ -476,13 +476,19 @@ TEST(CadTrimmedSamples, ScrewStepsCertifiedDirectionClearsEveryNormalOcctSamples
               sampledCap * 180.0 / M_PI);
   EXPECT_GE(clearance, lower.certifiedAlphaRad - 1e-9);
   EXPECT_LE(lower.certifiedAlphaRad, sampledCap + 1e-9);
-  // A spread no budget can follow is an error naming the face, not a face skipped.
+  // A spread no budget can follow is an error naming the face (exactFaces, which skips what it
+  // cannot take, lists the face as skipped, and the commands take the part through its
+  // tessellation).
   options.trimSplit.normalSpreadRad = 1e-9;
+  const scallop::CadImport skipping = part.exactFaces(options);
+  ASSERT_FALSE(skipping.skipped.empty());
+  EXPECT_NE(skipping.skipped[0].reason.find("more than 20000 pieces in all"), std::string::npos)
+      << skipping.skipped[0].reason;
   try {
-    (void)part.exactFaces(options);
+    (void)scallop::importCad(path, options);
     ADD_FAILURE() << "no error past the budget of pieces";
   } catch (const scallop::Error& error) {
-    scallop::test::expectMessageContains(error.what(), {"screw.step", "face 3", "more than 20000 pieces", "spread"},
+    scallop::test::expectMessageContains(error.what(), {"screw.step", "face 3", "more than 20000 pieces in all", "spread"},
                                          "budget");
   }
 }

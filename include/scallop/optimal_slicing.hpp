@@ -68,7 +68,10 @@
 // No complement: when the Gauss map's complement is empty within its tolerance, "no
 //         direction exists" is said only with a proof (normal_coverage.hpp: the normals cover
 //         the sphere; method "covered", alpha* = 0). Without one, the polish runs from the
-//         lattice's seeds and the certificate proves what it can (method "lattice").
+//         lattice's seeds and the certificate proves what it can (method "lattice"), unless
+//         OptimalSlicingOptions::noComplement says otherwise (method "open": alpha 0, nothing
+//         searched; for a superset of normals, as a trimmed face's pieces, where nothing better
+//         than 0 could be said of the face, and the search over thousands of pieces is long).
 // Degenerate surfaces: a plane (Omega two points) gives alpha* = 90 degrees with N* any
 //         direction orthogonal to the normal (one is returned, `method` "plane"); a surface
 //         whose normals the Gauss map takes for a point (within the tolerance, or too close
@@ -108,6 +111,13 @@ struct OptimalSlicingOptions {
   /// same circle, much faster); false: always on the full-resolution domain (for
   /// comparison and tests).
   bool coarseToFine = true;
+  /// What to do when the Gauss map leaves no direction free within its tolerance:
+  enum class NoComplement {
+    proveThenSearch,  ///< prove the normals cover the sphere ("covered"), else polish the lattice's seeds ("lattice")
+    prove,            ///< the proof alone; without it, method "open" (alpha 0, nothing searched)
+    stop,             ///< neither: method "open" at once (alpha >= 0 is all that is said)
+  };
+  NoComplement noComplement = NoComplement::proveThenSearch;
 };
 
 struct OptimalSlicing {
@@ -127,7 +137,8 @@ struct OptimalSlicing {
   /// complement and a proof that the normals cover the sphere says alpha* = 0 exactly (any
   /// direction; `coverage`); "lattice": no complement within the map's tolerance but no such
   /// proof either: N* is the best direction the lattice's seeds polish to, its alpha
-  /// certified like any other (an honest lower bound, possibly 0).
+  /// certified like any other (an honest lower bound, possibly 0); "open": the same without
+  /// the search (OptimalSlicingOptions::noComplement), alpha 0 at the pole.
   std::string method = "medial-axis";
   NormalCoverage coverage;  ///< the covering proof, tried when the complement is empty
   GaussMap gaussMap;

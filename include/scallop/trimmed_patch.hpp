@@ -62,7 +62,7 @@ struct TrimSplitOptions {
   /// Boundary cells are split until their normals spread by at most this (radians, > 0).
   /// The pieces grow as 1 / spread along the trimming curves (measured on OCCT's screw.step,
   /// `scallop orient` in all: 938 pieces at 2 degrees, 1.8 s; 4,152 at 0.5, 7.4 s; 8,576 at
-  /// 0.25, 15 s).
+  /// 0.25, 15 s; CadImportOptions::maxTrimPieces bounds them).
   double normalSpreadRad = 2.0 * std::numbers::pi / 180.0;
   /// Deepest quadtree level, 1 .. 20 (cells of 2^-depth in u and v).
   int maxDepth = 14;
