@@ -960,7 +960,9 @@ std::string trimmedOrientationToJson(const OptimalSlicing& result, double tolera
   trimmed["largest_spread_deg"] = toDegrees(facts.largestSpreadRad);
   trimmed["alpha_lower_deg"] = toDegrees(result.certified ? result.certifiedAlphaRad : result.alphaRad);
   if (facts.inside != nullptr) {
-    trimmed["alpha_upper_deg"] = toDegrees(facts.inside->alphaRad);
+    // Without a complement and without a covering proof the inside pieces bound nothing.
+    const bool bounds = facts.inside->method != "open" && facts.inside->method != "lattice";
+    trimmed["alpha_upper_deg"] = bounds ? Json(toDegrees(facts.inside->alphaRad)) : Json(nullptr);
     trimmed["upper_method"] = facts.inside->method;
     trimmed["upper_normal"] = {facts.inside->normal.x, facts.inside->normal.y, facts.inside->normal.z};
     trimmed["seconds"] = facts.inside->seconds;

@@ -716,6 +716,30 @@ TEST_F(CadTessellationCli, OrientBracketsATrimmedPartsAlphaBetweenCertifiedBound
   fs::remove(workDir_ / "pocket.step");
 }
 
+// Real data whose pieces leave no direction free (OCCT's hammer.iges, 23 of 45 faces trimmed):
+// the lower bound is 0 with nothing searched, and the inside pieces, unproven to cover the
+// sphere, bound nothing: no number is printed or written as if it were a bound.
+TEST_F(CadTessellationCli, ATrimmedPartWhosePiecesLeaveNoDirectionFreeClaimsNoBound) {
+  const std::string path = kOcctSamples + "/iges/hammer.iges";
+  if (!fs::exists(path)) GTEST_FAIL() << path << " is missing: Debian's occt-misc package installs it";
+  const scallop::test::RunResult orient = run("orient " + path + " --json o.json");
+  ASSERT_EQ(orient.exitCode, 0) << orient.err;
+  EXPECT_NE(orient.err.find("alpha* >= 0 (the pieces"), std::string::npos) << orient.err;
+  const auto json = nlohmann::json::parse(scallop::test::readFile(workDir_ / "o.json"));
+  EXPECT_EQ(json["method"], "open");
+  EXPECT_EQ(json["alpha_deg"].get<double>(), 0.0);
+  const auto& trimmed = json["trimmed"];
+  EXPECT_EQ(trimmed["faces"], 23);
+  if (trimmed["upper_method"] == "covered") {
+    EXPECT_EQ(trimmed["alpha_upper_deg"].get<double>(), 0.0);
+  } else {
+    EXPECT_EQ(trimmed["upper_method"], "open");
+    EXPECT_TRUE(trimmed["alpha_upper_deg"].is_null());
+    EXPECT_NE(orient.err.find("no upper bound"), std::string::npos) << orient.err;
+  }
+  fs::remove(workDir_ / "o.json");
+}
+
 TEST_F(CadTessellationCli, TessellationOptionsAreRefusedWhereTheyDoNotApply) {
   writeStep(pocketBlock(), workDir_ / "pocket.step", "MM");
   expectCleanFailure(run("plan pocket.step --tessellate --skip-faces --out out"), {"pocket.step", "--skip-faces"},

@@ -78,9 +78,9 @@ struct TrimmedFacts {
 ///  "alpha_lower_deg" (the certified alpha, or alpha_deg when not certified),
 ///  "alpha_upper_deg" (alpha* of the inside pieces alone, a subset of the normals: no
 ///  direction does better on the part, within the Gauss map's tolerance; null without inside
-///  pieces), "upper_method" (that slicing's method: "covered" when the inside pieces' normals
-///  provably cover the sphere, alpha* = 0; "open" when their Gauss map leaves no direction
-///  free without such a proof, and the value is then no bound),
+///  pieces, or when it bounds nothing), "upper_method" (that slicing's method: "covered" when
+///  the inside pieces' normals provably cover the sphere, alpha* = 0; "open" when their Gauss
+///  map leaves no direction free without such a proof: alpha_upper_deg is then null),
 ///  "upper_normal" (that slicing's N*, or null), "seconds" (of that slicing)}.
 std::string trimmedOrientationToJson(const OptimalSlicing& result, double toleranceDeg, const TrimmedFacts& facts);
 
