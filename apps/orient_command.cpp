@@ -69,16 +69,23 @@ std::string jsonDestination(const OrientOptions& options) {
   return options.svgDir.empty() ? std::string(kStandardStream) : std::string();
 }
 
-// `orient` on an STL mesh (mesh_slicing.hpp): the largest empty cap of the +-facet normals.
-void runOrientMesh(const OrientOptions& options) {
-  const std::string& path = options.surface.input;
+// The options of a Bezier surface's Gauss map, refused by name for a mesh's largest empty cap
+// (`what`: "a mesh", "a tessellated part").
+void rejectSurfaceOptions(const OrientOptions& options, const std::string& source, const char* what) {
   const auto reject = [&](bool given, const char* option, const char* why) {
-    if (given) throw Error(fmt::format("{}: {} {}; not for a mesh", path, option, why));
+    if (given) throw Error(fmt::format("{}: {} {}; not for {}", source, option, why, what));
   };
   reject(!options.surface.patches.empty(), "--patches", "selects Bezier patches");
   reject(!options.tolerance.empty(), "--tolerance", "is the polygonal Gauss map's (a mesh's is exact)");
   reject(!options.svgDir.empty(), "--svg-dir", "draws a surface's Gauss map");
   reject(options.noCertify || options.latticeSeeds, "--no-certify/--lattice-seeds", "apply to Bezier surfaces");
+  reject(!options.trimSpread.empty(), "--trim-spread", "follows a trimmed face's curves with Bezier pieces");
+}
+
+// `orient` on an STL mesh (mesh_slicing.hpp): the largest empty cap of the +-facet normals.
+void runOrientMesh(const OrientOptions& options) {
+  const std::string& path = options.surface.input;
+  rejectSurfaceOptions(options, path, "a mesh");
   const auto start = std::chrono::steady_clock::now();
   const StlMesh mesh = loadStlMesh(path, options.units, options.dropZeroArea);
   const MeshSlicing result = optimalMeshSlicing(mesh.mesh);
@@ -96,19 +103,13 @@ void runOrientMesh(const OrientOptions& options) {
   }
 }
 
-// `orient` on a STEP or IGES part with faces the exact importer refuses (trimmed, rational),
-// or with --tessellate: the largest empty cap of the +-exact normals sampled at its
+// `orient` on a STEP or IGES part with faces the exact importer refuses (or trimmed faces
+// past the budget of pieces), or with --tessellate: the largest empty cap of the +-exact normals sampled at its
 // tessellation's nodes and inside its triangles: an upper bound of the part's alpha*, not
 // certified.
 void runOrientTessellated(const OrientOptions& options, const CadPart& part, const std::optional<CadImport>& exact) {
   const std::string source = sourceName(options.surface);
-  const auto reject = [&](bool given, const char* option, const char* why) {
-    if (given) throw Error(fmt::format("{}: {} {}; not for a tessellated part", source, option, why));
-  };
-  reject(!options.surface.patches.empty(), "--patches", "selects Bezier patches");
-  reject(!options.tolerance.empty(), "--tolerance", "is the polygonal Gauss map's (a mesh's is exact)");
-  reject(!options.svgDir.empty(), "--svg-dir", "draws a surface's Gauss map");
-  reject(options.noCertify || options.latticeSeeds, "--no-certify/--lattice-seeds", "apply to Bezier surfaces");
+  rejectSurfaceOptions(options, source, "a tessellated part");
   const auto start = std::chrono::steady_clock::now();
   const std::string jsonPath = jsonDestination(options);
   const bool talk = jsonPath != kStandardStream;
@@ -267,6 +268,11 @@ void runOrient(const OrientOptions& options) {
   }
   exactOptions.trimSplit.normalSpreadRad = trimSpreadDeg * (std::numbers::pi / 180.0);
   const CadRoute route = cadRoute(options.surface, options.tessellate, options.deflection, exactOptions);
+  // An asked spread that some face cannot be taken at (past the budget of pieces, say) is
+  // refused with that face's reason, not silently traded for the tessellation.
+  if (!options.trimSpread.empty() && route.exact && !route.exact->skipped.empty())
+    throw Error(fmt::format("{}: --trim-spread {}: {}", sourceName(options.surface), options.trimSpread,
+                            route.exact->skipped.front().reason));
   if (!options.trimSpread.empty() && !(route.exact && route.exact->trimmedFaces > 0))
     throw Error(fmt::format("{}: --trim-spread is for STEP and IGES parts with trimmed faces, taken exactly",
                             sourceName(options.surface)));
@@ -402,8 +408,9 @@ void addOrientCommand(CLI::App& app) {
                    "safety net beside the medial axis; off: the paper's method alone)");
   addStlOptions(*orient, options->units, options->dropZeroArea);
   orient->add_flag("--tessellate", options->tessellate,
-                   "STEP/IGES: orient the part by its tessellation's facets (not certified) even when every face "
-                   "could be imported exactly; parts with trimmed or rational faces are oriented so without it");
+                   "STEP/IGES: orient the part by its tessellation's sampled normals (an upper bound, not certified) "
+                   "even when every face could be taken exactly; parts with faces that cannot (or with trimmed "
+                   "faces past the budget of pieces) are oriented so without it");
   orient->add_option("--trim-spread", options->trimSpread,
                      fmt::format("STEP/IGES trimmed faces: split the pieces crossing a trimming curve until their "
                                  "normals spread by at most DEG degrees (default {}); alpha* is then bounded within "

@@ -57,14 +57,7 @@ struct PathsOptions {
 
 // What paths asks of a mesh raster (its progress lines off: paths prints one summary).
 MeshRasterRequest meshRequest(const PathsOptions& options) {
-  MeshRasterRequest request;
-  request.source = sourceName(options.surface);
-  request.command = "paths";
-  request.toolRadius = options.toolRadius;
-  request.scallopHeight = options.scallopHeight;
-  request.spacing = options.spacing;
-  request.quiet = true;
-  return request;
+  return {sourceName(options.surface), "paths", options.toolRadius, options.scallopHeight, options.spacing, true};
 }
 
 // `paths` on a triangle mesh (an STL file, or a STEP/IGES part's tessellation): the raster of

@@ -119,14 +119,8 @@ void rejectMeshOptions(const PlanOptions& options, const char* what) {
 
 // What plan asks of a mesh raster.
 MeshRasterRequest meshRequest(const PlanOptions& options) {
-  MeshRasterRequest request;
-  request.source = sourceName(options.surface);
-  request.command = "plan";
-  request.toolRadius = options.toolRadius;
-  request.scallopHeight = options.scallopHeight;
-  request.spacing = options.spacing;
-  request.quiet = options.quiet;
-  return request;
+  return {sourceName(options.surface), "plan", options.toolRadius, options.scallopHeight, options.spacing,
+          options.quiet};
 }
 
 // `plan` on an STL mesh: raster passes of exact drop lines (mesh_raster.hpp), every move proven

@@ -238,9 +238,18 @@ Vec3 secondDerivative(const BezierPatch& patch, double u, double v, int du, int 
   return anyPartial(patch, u, v, du, dv);
 }
 
+// r_u x r_v: two partials of a polynomial patch; one quotient-rule pass of a rational one.
+Vec3 firstDerivativesCross(const BezierPatch& patch, double u, double v) {
+  if (patch.rational()) {
+    const PatchDerivatives d = rationalDerivatives(patch, u, v, nullptr);
+    return cross(d.u, d.v);
+  }
+  return cross(partial(patch, u, v, 1, 0), partial(patch, u, v, 0, 1));
+}
+
 Vec3 normalVector(const BezierPatch& patch, double u, double v) {
   requireValid(patch, "normalVector");
-  return cross(anyPartial(patch, u, v, 1, 0), anyPartial(patch, u, v, 0, 1));
+  return firstDerivativesCross(patch, u, v);
 }
 
 double normalRoundingThreshold(const BezierPatch& patch) {
@@ -299,7 +308,7 @@ constexpr double kCornerRayRadius = 1e-6;
 
 Vec3 unitNormal(const BezierPatch& patch, double u, double v) {
   requireValid(patch, "unitNormal");
-  const Vec3 normal = cross(anyPartial(patch, u, v, 1, 0), anyPartial(patch, u, v, 0, 1));
+  const Vec3 normal = firstDerivativesCross(patch, u, v);
   const double length = norm(normal);
   const double threshold = normalRoundingThreshold(patch);
   if (length > threshold) return normal / length;
@@ -510,28 +519,45 @@ CurvatureSign curvatureSignPolynomial(const BezierPatch& patch) {
 
 namespace {
 
+// The Bernstein bases of a patch's two directions at (u, v) with their first and second
+// derivatives: three rows per direction (value, first, second), su and sv apart; on the stack
+// up to degree 15. M, N >= 0 fix the degrees at compile time. Not copyable: bu points into it.
+template <int M = -1, int N = -1>
+struct BasisTable {
+  static constexpr int kSmall = 16;
+  int m, n, su, sv;
+  std::array<double, 6 * kSmall> small;
+  std::vector<double> large;
+  double* bu;
+  double* bv;
+  BasisTable(const BezierPatch& patch, double u, double v)
+      : m(M >= 0 ? M : patch.degreeU), n(N >= 0 ? N : patch.degreeV) {
+    const bool onStack = std::max(m, n) < kSmall;
+    su = onStack ? kSmall : m + 1;
+    sv = onStack ? kSmall : n + 1;
+    bu = small.data();
+    if (!onStack) {
+      large.resize(3 * static_cast<std::size_t>(su + sv));
+      bu = large.data();
+    }
+    bv = bu + 3 * su;
+    basisDerivatives<M>(m, u, bu, bu + su, bu + 2 * su);
+    basisDerivatives<N>(n, v, bv, bv + sv, bv + 2 * sv);
+  }
+  BasisTable(const BasisTable&) = delete;
+  BasisTable& operator=(const BasisTable&) = delete;
+};
+
 // derivativesToSecondOrder's sums; M, N >= 0 fix the degrees at compile time (the same
 // operations in the same order, unrolled).
 template <int M = -1, int N = -1>
 PatchDerivatives derivativesImpl(const BezierPatch& patch, double u, double v) {
-  const int m = M >= 0 ? M : patch.degreeU;
-  const int n = N >= 0 ? N : patch.degreeV;
-  // Three rows of basis values per direction (value, first, second derivative), su and sv
-  // apart; on the stack up to degree 15.
-  constexpr int kSmall = 16;
-  const bool onStack = std::max(m, n) < kSmall;
-  const int su = onStack ? kSmall : m + 1;
-  const int sv = onStack ? kSmall : n + 1;
-  std::array<double, 6 * kSmall> small;
-  std::vector<double> large;
-  double* bu = small.data();
-  if (!onStack) {
-    large.resize(3 * static_cast<std::size_t>(su + sv));
-    bu = large.data();
-  }
-  double* bv = bu + 3 * su;
-  basisDerivatives<M>(m, u, bu, bu + su, bu + 2 * su);
-  basisDerivatives<N>(n, v, bv, bv + sv, bv + 2 * sv);
+  const BasisTable<M, N> basis(patch, u, v);
+  const int m = M >= 0 ? M : basis.m;  // constants when fixed: the loops below unroll
+  const int n = N >= 0 ? N : basis.n;
+  const int su = basis.su, sv = basis.sv;
+  const double* bu = basis.bu;
+  const double* bv = basis.bv;
   PatchDerivatives out{};
   for (int j = 0; j <= m; ++j) {
     Vec3 row0{}, row1{}, row2{};  // the row's sums with the v basis and its derivatives
@@ -555,22 +581,12 @@ PatchDerivatives derivativesImpl(const BezierPatch& patch, double u, double v) {
 // r_uv = (X_uv - w_u r_v - w_v r_u - w_uv r) / w, and likewise in v.
 template <int M = -1, int N = -1>
 PatchDerivatives rationalImpl(const BezierPatch& patch, double u, double v, Vec3* value) {
-  const int m = M >= 0 ? M : patch.degreeU;
-  const int n = N >= 0 ? N : patch.degreeV;
-  constexpr int kSmall = 16;
-  const bool onStack = std::max(m, n) < kSmall;
-  const int su = onStack ? kSmall : m + 1;
-  const int sv = onStack ? kSmall : n + 1;
-  std::array<double, 6 * kSmall> small;
-  std::vector<double> large;
-  double* bu = small.data();
-  if (!onStack) {
-    large.resize(3 * static_cast<std::size_t>(su + sv));
-    bu = large.data();
-  }
-  double* bv = bu + 3 * su;
-  basisDerivatives<M>(m, u, bu, bu + su, bu + 2 * su);
-  basisDerivatives<N>(n, v, bv, bv + sv, bv + 2 * sv);
+  const BasisTable<M, N> basis(patch, u, v);
+  const int m = M >= 0 ? M : basis.m;  // constants when fixed: the loops below unroll
+  const int n = N >= 0 ? N : basis.n;
+  const int su = basis.su, sv = basis.sv;
+  const double* bu = basis.bu;
+  const double* bv = basis.bv;
   Vec3 x{}, xu{}, xv{}, xuu{}, xuv{}, xvv{};
   double w = 0.0, wu = 0.0, wv = 0.0, wuu = 0.0, wuv = 0.0, wvv = 0.0;
   for (int j = 0; j <= m; ++j) {
@@ -620,6 +636,14 @@ PatchDerivatives rationalDerivatives(const BezierPatch& patch, double u, double 
 PatchDerivatives derivativesToSecondOrder(const BezierPatch& patch, double u, double v) {
   requireValid(patch, "derivativesToSecondOrder");
   if (patch.rational()) return rationalDerivatives(patch, u, v, nullptr);
+  if (patch.degreeU == 3 && patch.degreeV == 3) return derivativesImpl<3, 3>(patch, u, v);
+  return derivativesImpl<>(patch, u, v);
+}
+
+PatchDerivatives derivativesToSecondOrder(const BezierPatch& patch, double u, double v, Vec3& value) {
+  requireValid(patch, "derivativesToSecondOrder");
+  if (patch.rational()) return rationalDerivatives(patch, u, v, &value);
+  value = partial(patch, u, v, 0, 0);
   if (patch.degreeU == 3 && patch.degreeV == 3) return derivativesImpl<3, 3>(patch, u, v);
   return derivativesImpl<>(patch, u, v);
 }

@@ -194,6 +194,14 @@ std::vector<gp_Pnt2d> decidingPoints(Handle(Geom2d_Curve) curve, double first, d
 
 void snapToPeriods(Rectangle& r, const Handle(Geom_Surface)& surface);
 
+// The edges' 3D tolerance as parameter tolerances of the surface (at least OCCT's parametric
+// confusion).
+void setParametricTolerances(Rectangle& r, const Handle(Geom_Surface)& surface, double tolerance3d) {
+  const GeomAdaptor_Surface adaptor(surface);
+  r.tolU = std::max(Precision::PConfusion(), adaptor.UResolution(tolerance3d));
+  r.tolV = std::max(Precision::PConfusion(), adaptor.VResolution(tolerance3d));
+}
+
 Rectangle parameterRectangle(const TopoDS_Face& face, const Handle(Geom_Surface)& surface) {
   int wires = 0;
   for (TopoDS_Iterator it(face); it.More(); it.Next()) wires += it.Value().ShapeType() == TopAbs_WIRE ? 1 : 0;
@@ -231,9 +239,7 @@ Rectangle parameterRectangle(const TopoDS_Face& face, const Handle(Geom_Surface)
     }
     tolerance3d = std::max(tolerance3d, e.tolerance);
   }
-  const GeomAdaptor_Surface adaptor(surface);
-  r.tolU = std::max(Precision::PConfusion(), adaptor.UResolution(tolerance3d));
-  r.tolV = std::max(Precision::PConfusion(), adaptor.VResolution(tolerance3d));
+  setParametricTolerances(r, surface, tolerance3d);
   // Each edge lies on one side; the sides' covered lengths add up (edges of a valid wire do
   // not overlap).
   std::array<double, 4> covered{};  // u = u0, u = u1, v = v0, v = v1
@@ -526,9 +532,7 @@ Rectangle boundsRectangle(const TopoDS_Face& face, const Handle(Geom_Surface)& s
   double tolerance3d = 0.0;
   for (TopExp_Explorer it(face, TopAbs_EDGE); it.More(); it.Next())
     tolerance3d = std::max(tolerance3d, BRep_Tool::Tolerance(TopoDS::Edge(it.Current())));
-  const GeomAdaptor_Surface adaptor(surface);
-  r.tolU = std::max(Precision::PConfusion(), adaptor.UResolution(tolerance3d));
-  r.tolV = std::max(Precision::PConfusion(), adaptor.VResolution(tolerance3d));
+  setParametricTolerances(r, surface, tolerance3d);
   double su0 = 0.0, su1 = 0.0, sv0 = 0.0, sv1 = 0.0;
   surface->Bounds(su0, su1, sv0, sv1);
   if (!surface->IsUPeriodic()) r.u0 = std::max(r.u0, su0), r.u1 = std::min(r.u1, su1);

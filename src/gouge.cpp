@@ -266,7 +266,12 @@ void halveTreeNet(const PatchTree& tree, const Vec3* net, Vec3* out) {
     return;
   }
   const std::size_t count = tree.points;
-  std::vector<Vec3> homogeneous(count), weights(count), halvedPoints(4 * count), halvedWeights(4 * count);
+  // Per-thread scratch: this runs for every halving of a rational cell.
+  thread_local std::vector<Vec3> homogeneous, weights, halvedPoints, halvedWeights;
+  homogeneous.resize(count);
+  weights.resize(count);
+  halvedPoints.resize(4 * count);
+  halvedWeights.resize(4 * count);
   for (std::size_t i = 0; i < count; ++i) {
     homogeneous[i] = net[count + i].x * net[i];
     weights[i] = net[count + i];
@@ -319,9 +324,10 @@ struct Jet {
   Vec3 r, ru, rv, ruu, ruv, rvv;
 };
 Jet jetAt(const BezierPatch& patch, double u, double v) {
-  if (patch.rational()) {  // the quotient rule (bezier.hpp)
-    const PatchDerivatives d = derivativesToSecondOrder(patch, u, v);
-    return {point(patch, u, v), d.u, d.v, d.uu, d.uv, d.vv};
+  if (patch.rational()) {  // the quotient rule (bezier.hpp), value and derivatives in one pass
+    Vec3 r;
+    const PatchDerivatives d = derivativesToSecondOrder(patch, u, v, r);
+    return {r, d.u, d.v, d.uu, d.uv, d.vv};
   }
   const int m = patch.degreeU;
   const int n = patch.degreeV;
@@ -755,9 +761,10 @@ void checkSurface(const Surface& surface) {
       if (patch.weights.size() != expected)
         throw Error(fmt::format("surface distance: patches[{}]: {} weights for {} control points", i,
                                 patch.weights.size(), expected));
+      const double largest = *std::max_element(patch.weights.begin(), patch.weights.end());
       for (std::size_t c = 0; c < patch.weights.size(); ++c)
         if (!(patch.weights[c] > 0.0) || !std::isfinite(patch.weights[c]) ||
-            !(patch.weights[c] * kMaxWeightRatio >= *std::max_element(patch.weights.begin(), patch.weights.end())))
+            !(patch.weights[c] * kMaxWeightRatio >= largest))
           throw Error(fmt::format("surface distance: patches[{}]: weight {} is {}: weights must be positive, finite "
                                   "and within a ratio of {:g}",
                                   i, c, patch.weights[c], kMaxWeightRatio));

@@ -1115,6 +1115,19 @@ std::string stereographicSvg(const OptimalSlicing& result) {
   return svg;
 }
 
+namespace {
+
+// The largest empty cap's figures, which a mesh's and a tessellation's documents share.
+void addEmptyCap(nlohmann::ordered_json& document, const MeshSlicing& result) {
+  document["distinct_normals"] = result.distinctNormals;
+  document["hull_facets"] = result.hullFacets;
+  document["great_circle"] = result.greatCircle;
+  document["normal"] = {result.normal.x, result.normal.y, result.normal.z};
+  document["alpha_deg"] = toDegrees(result.alphaRad);
+}
+
+}  // namespace
+
 std::string meshOrientationToJson(const MeshSlicing& result, const StlMesh& mesh, const std::string& source,
                                   double seconds) {
   nlohmann::ordered_json document;
@@ -1125,11 +1138,7 @@ std::string meshOrientationToJson(const MeshSlicing& result, const StlMesh& mesh
   document["triangles_read"] = mesh.trianglesRead;
   document["zero_area_dropped"] = mesh.zeroAreaDropped;
   document["triangles"] = result.triangles;
-  document["distinct_normals"] = result.distinctNormals;
-  document["hull_facets"] = result.hullFacets;
-  document["great_circle"] = result.greatCircle;
-  document["normal"] = {result.normal.x, result.normal.y, result.normal.z};
-  document["alpha_deg"] = toDegrees(result.alphaRad);
+  addEmptyCap(document, result);
   document["seconds"] = seconds;
   return json::format(document);
 }
@@ -1145,11 +1154,7 @@ std::string tessellationOrientationToJson(const MeshSlicing& result, const Tesse
   document["deviation"] = facts.deviation;
   document["facet_normal_angle_deg"] = toDegrees(facts.normalAngleRad);
   document["normals_sampled"] = facts.normalsSampled;
-  document["distinct_normals"] = result.distinctNormals;
-  document["hull_facets"] = result.hullFacets;
-  document["great_circle"] = result.greatCircle;
-  document["normal"] = {result.normal.x, result.normal.y, result.normal.z};
-  document["alpha_deg"] = toDegrees(result.alphaRad);
+  addEmptyCap(document, result);
   document["alpha_is"] = "upper bound";
   document["certified"] = false;
   document["seconds"] = seconds;

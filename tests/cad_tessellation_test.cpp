@@ -740,6 +740,21 @@ TEST_F(CadTessellationCli, ATrimmedPartWhosePiecesLeaveNoDirectionFreeClaimsNoBo
   fs::remove(workDir_ / "o.json");
 }
 
+// An asked spread past the budget of pieces is refused with the face's reason; without it the
+// same part (here at the default) is oriented exactly, and an STL mesh refuses the option.
+TEST_F(CadTessellationCli, AnAskedTrimSpreadPastTheBudgetIsRefusedWithItsReason) {
+  const std::string path = kOcctSamples + "/step/screw.step";
+  if (!fs::exists(path)) GTEST_FAIL() << path << " is missing: Debian's occt-misc package installs it";
+  expectCleanFailure(run("orient " + path + " --trim-spread 0.1 --json o.json"),
+                     {"screw.step", "--trim-spread 0.1", "face", "pieces"}, nullptr);
+  writeStep(pocketBlock(), workDir_ / "pocket.step", "MM");
+  const scallop::test::RunResult mesh = run("orient pocket.step --tessellate --trim-spread 1 --json o.json");
+  EXPECT_EQ(mesh.exitCode, 1) << mesh.err;
+  EXPECT_NE(mesh.err.find("--trim-spread"), std::string::npos) << mesh.err;
+  EXPECT_FALSE(fs::exists(workDir_ / "o.json"));
+  fs::remove(workDir_ / "pocket.step");
+}
+
 TEST_F(CadTessellationCli, TessellationOptionsAreRefusedWhereTheyDoNotApply) {
   writeStep(pocketBlock(), workDir_ / "pocket.step", "MM");
   expectCleanFailure(run("plan pocket.step --tessellate --skip-faces --out out"), {"pocket.step", "--skip-faces"},

@@ -116,6 +116,8 @@ struct PatchDerivatives {
   Vec3 u, v, uu, uv, vv;
 };
 PatchDerivatives derivativesToSecondOrder(const BezierPatch& patch, double u, double v);
+/// The same and r(u, v) itself, in `value` (a rational patch's from the same pass).
+PatchDerivatives derivativesToSecondOrder(const BezierPatch& patch, double u, double v, Vec3& value);
 /// (r_uu . N)(r_vv . N) - (r_uv . N)^2 with N = r_u x r_v at (u, v): the value of
 /// gaussianCurvatureNumerator there, from derivativesToSecondOrder (cheaper than the
 /// polynomial of bidegree (6m - 4, 6n - 4)).
