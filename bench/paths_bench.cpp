@@ -18,12 +18,20 @@
 //                             the surface's footprint grown by R, row by row: one cutter for
 //                             the grid (1: each point seeded by the last contact) or a new one
 //                             per point (0: cold); points per second
+//   BM_DistanceManyPatches/<N>  SurfaceDistance::closest from 4,096 points (fixed seed) within
+//                             0.5 in of a surface of N translated copies of paper-1's patch
+//                             side by side (on a 3 in grid): queries per second as the
+//                             surface grows (the hierarchy of patch boxes: about flat in N;
+//                             a scan of every patch's root cell would fall as 1 / N)
 
 #include <benchmark/benchmark.h>
+#include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <optional>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -203,6 +211,33 @@ void BM_DropCutter(benchmark::State& state) {
   state.SetLabel(std::string(surfaceName(state)) + (warm ? " warm" : " cold"));
 }
 
+void BM_DistanceManyPatches(benchmark::State& state) {
+  const auto copies = static_cast<std::size_t>(state.range(0));
+  const scallop::BezierPatch one = scallop::exampleSurface("paper-1").patches.front();
+  scallop::Surface surface;
+  const auto side = static_cast<std::size_t>(std::ceil(std::sqrt(static_cast<double>(copies))));
+  for (std::size_t i = 0; i < copies; ++i) {
+    scallop::BezierPatch patch = one;
+    const scallop::Vec3 shift{3.0 * static_cast<double>(i % side), 3.0 * static_cast<double>(i / side), 0.0};
+    for (scallop::Vec3& p : patch.control) p = p + shift;
+    surface.patches.push_back(std::move(patch));
+  }
+  const scallop::SurfaceDistance distance(surface);
+  std::mt19937_64 random(14);
+  std::uniform_real_distribution<double> across(0.0, 3.0 * static_cast<double>(side));
+  std::uniform_real_distribution<double> up(1.5, 2.0);
+  std::vector<scallop::Vec3> queries(4096);
+  for (scallop::Vec3& q : queries) q = {across(random), across(random), up(random)};
+  double sum = 0.0;
+  for (auto _ : state)
+    for (const scallop::Vec3& q : queries) sum += distance.closest(q).distance;
+  benchmark::DoNotOptimize(sum);
+  state.counters["queries_per_s"] =
+      benchmark::Counter(static_cast<double>(queries.size()), benchmark::Counter::kIsIterationInvariantRate);
+  state.SetLabel(fmt::format("{} patches", copies));
+}
+
+BENCHMARK(BM_DistanceManyPatches)->Arg(1)->Arg(16)->Arg(256)->Arg(4096)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_DropCutter)->Args({1, 1})->Args({1, 0})->Args({2, 1})->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LinkContour)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LinkRaster)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);

@@ -54,11 +54,25 @@ struct PatchTree {
   double scale = 0.0;  // the largest |coordinate| of the patch's control points
 };
 
+// A node of the hierarchy of the patches' root boxes: a leaf holds `count` patches
+// (nodePatches_[first, first + count)), an inner node two children. Its rounding allowance
+// bounds its patches' root cells' (cellAllowance at depth 0): coefficient (scale + query scale).
+struct PatchNode {
+  Box box;
+  std::uint32_t first = 0;
+  std::uint32_t count = 0;  // 0: an inner node
+  std::uint32_t left = 0;
+  std::uint32_t right = 0;
+  double allowanceCoefficient = 0.0;
+  double scale = 0.0;
+};
+
 }  // namespace detail
 
 namespace {
 
 using detail::Box;
+using detail::PatchNode;
 using detail::PatchTree;
 
 constexpr double kUnitRoundoff = std::numeric_limits<double>::epsilon() / 2;  // u = 2^-53
@@ -659,13 +673,16 @@ struct CellStore {
 // of magnitude `queryScale`; the cell's control net (in the tree, or in the cell store);
 // its corners not seen before (`fresh`, a bit per corner), surface points, offered to
 // `consider`; and its axis-aligned box.
-double cellAllowance(const PatchTree& tree, int depth, double queryScale) {
+double allowanceCoefficient(const PatchTree& tree, int depth) {
   // A rational net's points are quotients X / w of halved homogeneous points and weights:
   // their errors, each of the polynomial net's order relative to w_max |p|_max and w_max,
   // are divided by w >= w_min, so at most 2 w_max / w_min times the polynomial allowance.
   const double quotient = tree.rational ? 2.0 * tree.weightRatio + 1.0 : 1.0;
-  return quotient * (3.0 * (tree.degreeU + tree.degreeV) * (depth + 1) + 16.0) * kUnitRoundoff *
-         (tree.scale + queryScale);
+  return quotient * (3.0 * (tree.degreeU + tree.degreeV) * (depth + 1) + 16.0) * kUnitRoundoff;
+}
+
+double cellAllowance(const PatchTree& tree, int depth, double queryScale) {
+  return allowanceCoefficient(tree, depth) * (tree.scale + queryScale);
 }
 
 const Vec3* cellNet(const PatchTree& tree, const Cell& cell, const CellStore& store) {
@@ -689,10 +706,151 @@ template <class Consider>
   return cell.inTree ? tree.boxes[static_cast<std::size_t>(cell.depth)][cell.net] : store.boxes[cell.box];
 }
 
+// A node of the patches' hierarchy waiting in a search, by the lower bound of its box.
+struct NodeEntry {
+  double lower = 0.0;
+  std::uint32_t node = 0;
+};
+
+struct NodeByLowerBound {
+  bool operator()(const NodeEntry& a, const NodeEntry& b) const { return a.lower > b.lower; }  // min-heap
+};
+
 struct Scratch {
   std::vector<Cell> heap;
+  std::vector<NodeEntry> nodes;
   CellStore store;
 };
+
+// The hierarchy's walk shared by both searches. A surface of one leaf offers its patches'
+// root cells at once, in order (the search before the hierarchy, bit for bit); otherwise
+// nodes wait in their own heap and are opened while their lower bound is at most the
+// least of the queued cells', so cells and nodes are taken in the order of their bounds.
+// `lowerOf` bounds a node's box; `drop(lower)` is told of nodes that cannot matter.
+template <typename LowerOf, typename Keep, typename Drop, typename Offer>
+class NodeWalk {
+ public:
+  NodeWalk(const std::vector<PatchNode>& nodes, const std::vector<std::uint32_t>& patches, std::vector<NodeEntry>& heap,
+           const std::vector<Cell>& cells, LowerOf lowerOf, Keep keep, Drop drop, Offer offer)
+      : nodes_(nodes), patches_(patches), heap_(heap), cells_(cells), lowerOf_(lowerOf), keep_(keep), drop_(drop),
+        offer_(offer) {
+    heap_.clear();
+    if (nodes_.size() == 1) {
+      openLeaf(nodes_.front());
+    } else {
+      heap_.push_back({lowerOf_(nodes_.front()), 0});
+    }
+  }
+
+  // Opens the nodes that come before the least queued cell.
+  void advance() {
+    while (!heap_.empty()) {
+      if (!cells_.empty() && heap_.front().lower > cells_.front().lower) return;
+      std::pop_heap(heap_.begin(), heap_.end(), NodeByLowerBound{});
+      const NodeEntry entry = heap_.back();
+      heap_.pop_back();
+      if (!keep_(entry.lower)) {
+        drop_(entry.lower);
+        continue;
+      }
+      const PatchNode& node = nodes_[entry.node];
+      if (node.count > 0) {
+        openLeaf(node);
+        continue;
+      }
+      for (const std::uint32_t child : {node.left, node.right}) {
+        const double lower = lowerOf_(nodes_[child]);
+        if (!keep_(lower)) {
+          drop_(lower);
+          continue;
+        }
+        heap_.push_back({lower, child});
+        std::push_heap(heap_.begin(), heap_.end(), NodeByLowerBound{});
+      }
+    }
+  }
+
+  // The least bound of the nodes not opened (infinity when none is left).
+  double waiting() const { return heap_.empty() ? kInfinity : heap_.front().lower; }
+
+ private:
+  void openLeaf(const PatchNode& node) {
+    for (std::uint32_t k = 0; k < node.count; ++k)
+      offer_(Cell{0.0, patches_[node.first + k], 0, true, 0, 0, 0.0, 0.0}, 0b1111u);
+  }
+
+  const std::vector<PatchNode>& nodes_;
+  const std::vector<std::uint32_t>& patches_;
+  std::vector<NodeEntry>& heap_;
+  const std::vector<Cell>& cells_;
+  LowerOf lowerOf_;
+  Keep keep_;
+  Drop drop_;
+  Offer offer_;
+};
+
+// The hierarchy over the patches' root boxes (see the contract): median splits of the box
+// centres along the longest axis of their spread, leaves of at most kPatchesPerLeaf patches
+// in index order. Iterative (a stack of ranges), deterministic.
+void buildHierarchy(const std::vector<PatchTree>& trees, std::vector<PatchNode>& nodes,
+                    std::vector<std::uint32_t>& patches) {
+  patches.resize(trees.size());
+  for (std::size_t i = 0; i < trees.size(); ++i) patches[i] = static_cast<std::uint32_t>(i);
+  const auto centre = [&](std::uint32_t i) {
+    const Box& b = trees[i].boxes[0][0];
+    return 0.5 * (b.lo + b.hi);
+  };
+  struct Range {
+    std::size_t node, begin, end;
+  };
+  nodes.clear();
+  nodes.emplace_back();
+  std::vector<Range> stack{{0, 0, patches.size()}};
+  while (!stack.empty()) {
+    const Range range = stack.back();
+    stack.pop_back();
+    PatchNode node;
+    node.box = trees[patches[range.begin]].boxes[0][0];
+    Vec3 low = centre(patches[range.begin]), high = low;
+    for (std::size_t k = range.begin; k < range.end; ++k) {
+      const PatchTree& tree = trees[patches[k]];
+      const Box& b = tree.boxes[0][0];
+      node.box.lo = {std::min(node.box.lo.x, b.lo.x), std::min(node.box.lo.y, b.lo.y), std::min(node.box.lo.z, b.lo.z)};
+      node.box.hi = {std::max(node.box.hi.x, b.hi.x), std::max(node.box.hi.y, b.hi.y), std::max(node.box.hi.z, b.hi.z)};
+      node.scale = std::max(node.scale, tree.scale);
+      node.allowanceCoefficient = std::max(node.allowanceCoefficient, allowanceCoefficient(tree, 0));
+      const Vec3 c = centre(patches[k]);
+      low = {std::min(low.x, c.x), std::min(low.y, c.y), std::min(low.z, c.z)};
+      high = {std::max(high.x, c.x), std::max(high.y, c.y), std::max(high.z, c.z)};
+    }
+    if (range.end - range.begin <= kPatchesPerLeaf) {
+      std::sort(patches.begin() + static_cast<std::ptrdiff_t>(range.begin),
+                patches.begin() + static_cast<std::ptrdiff_t>(range.end));
+      node.first = static_cast<std::uint32_t>(range.begin);
+      node.count = static_cast<std::uint32_t>(range.end - range.begin);
+      nodes[range.node] = node;
+      continue;
+    }
+    const Vec3 spread = high - low;
+    const int axis = spread.x >= spread.y && spread.x >= spread.z ? 0 : (spread.y >= spread.z ? 1 : 2);
+    const auto key = [&](std::uint32_t i) {
+      const Vec3 c = centre(i);
+      return axis == 0 ? c.x : (axis == 1 ? c.y : c.z);
+    };
+    const std::size_t middle = range.begin + (range.end - range.begin) / 2;
+    std::nth_element(patches.begin() + static_cast<std::ptrdiff_t>(range.begin),
+                     patches.begin() + static_cast<std::ptrdiff_t>(middle),
+                     patches.begin() + static_cast<std::ptrdiff_t>(range.end),
+                     [&](std::uint32_t a, std::uint32_t b) { return key(a) < key(b) || (key(a) == key(b) && a < b); });
+    node.left = static_cast<std::uint32_t>(nodes.size());
+    node.right = node.left + 1;
+    nodes[range.node] = node;
+    nodes.emplace_back();
+    nodes.emplace_back();
+    stack.push_back({node.right, middle, range.end});
+    stack.push_back({node.left, range.begin, middle});
+  }
+}
 
 // Offers the four quarters of `cell` (subdivided at 1/2 in u and v): from the patch's tree
 // while it goes that deep, else from the cell store. Each quarter comes with the corners it
@@ -819,8 +977,9 @@ PatchTree buildTree(const BezierPatch& patch, int depth) {
 }
 
 // The branch and bound of the contract.
-ClosestPoint search(const Surface& surface, const std::vector<PatchTree>& trees, std::uint64_t id,
-                    double tolerance, std::size_t maxCells, Vec3 p, double cutoff) {
+ClosestPoint search(const Surface& surface, const std::vector<PatchTree>& trees, const std::vector<PatchNode>& nodes,
+                    const std::vector<std::uint32_t>& nodePatches, std::uint64_t id, double tolerance,
+                    std::size_t maxCells, Vec3 p, double cutoff) {
   if (!isFinite(p)) {
     throw Error(
         fmt::format("surface distance: the query point ({}, {}, {}) is not finite", p.x, p.y, p.z));
@@ -863,11 +1022,17 @@ ClosestPoint search(const Surface& surface, const std::vector<PatchTree>& trees,
     std::push_heap(heap.begin(), heap.end(), ByLowerBound{});
   };
 
-  for (std::size_t i = 0; i < trees.size(); ++i) {
-    offer({0.0, static_cast<std::uint32_t>(i), 0, true, 0, 0, 0.0, 0.0}, 0b1111u);
-  }
+  NodeWalk walk(
+      nodes, nodePatches, scratch.nodes, heap,
+      [&](const PatchNode& node) {
+        return std::max(0.0, boxDistance(node.box, p) - node.allowanceCoefficient * (node.scale + pScale));
+      },
+      [&](double lower) { return lower < level(); }, [&](double lower) { setAside = std::min(setAside, lower); },
+      offer);
   double lowerBound = kInfinity;  // of the cells still queued when the search stops
-  while (!heap.empty()) {
+  for (;;) {
+    walk.advance();
+    if (heap.empty()) break;
     std::pop_heap(heap.begin(), heap.end(), ByLowerBound{});
     const Cell cell = heap.back();
     heap.pop_back();
@@ -914,7 +1079,7 @@ ClosestPoint search(const Surface& surface, const std::vector<PatchTree>& trees,
   result.u = best.u;
   result.v = best.v;
   result.point = best.point;
-  result.lowerBound = std::max(0.0, std::min({lowerBound, setAside, best.distance}));
+  result.lowerBound = std::max(0.0, std::min({lowerBound, walk.waiting(), setAside, best.distance}));
   result.converged = best.distance - result.lowerBound <= tolerance || result.lowerBound >= cutoff;
   result.cells = cells;
   return result;
@@ -970,7 +1135,8 @@ double separatingPlaneSegmentDistance(const Vec3* net, int m, int n, const Query
   return std::max(0.0, least - std::max(dot(s.a, w), dot(s.b, w)));
 }
 
-SegmentClearance segmentSearch(const std::vector<PatchTree>& trees, std::uint64_t id, Vec3 a, Vec3 b,
+SegmentClearance segmentSearch(const std::vector<PatchTree>& trees, const std::vector<PatchNode>& nodes,
+                               const std::vector<std::uint32_t>& nodePatches, std::uint64_t id, Vec3 a, Vec3 b,
                                double clearance, std::size_t maxCells) {
   if (!isFinite(a) || !isFinite(b)) {
     throw Error(fmt::format("segment clearance: the segment ({}, {}, {}) - ({}, {}, {}) is not "
@@ -1015,10 +1181,20 @@ SegmentClearance segmentSearch(const std::vector<PatchTree>& trees, std::uint64_
     heap.push_back(cell);
     std::push_heap(heap.begin(), heap.end(), ByLowerBound{});
   };
-  for (std::size_t i = 0; i < trees.size() && !violated; ++i) {
-    offer({0.0, static_cast<std::uint32_t>(i), 0, true, 0, 0, 0.0, 0.0}, 0b1111u);
-  }
-  while (!heap.empty() && !violated) {
+  // A surface of one leaf offers its root cells in order, stopping at the first violation.
+  const auto offerUnlessViolated = [&](Cell cell, unsigned fresh) {
+    if (!violated) offer(cell, fresh);
+  };
+  NodeWalk walk(
+      nodes, nodePatches, scratch.nodes, heap,
+      [&](const PatchNode& node) {
+        return boxSegmentDistance(node.box, segment) - node.allowanceCoefficient * (node.scale + pScale);
+      },
+      [&](double lower) { return lower < clearance; }, [](double) {}, offerUnlessViolated);
+  for (;;) {
+    if (violated) break;
+    walk.advance();
+    if (heap.empty() || violated) break;
     std::pop_heap(heap.begin(), heap.end(), ByLowerBound{});
     const Cell cell = heap.back();
     heap.pop_back();
@@ -1196,10 +1372,21 @@ SurfaceDistance::SurfaceDistance(const Surface& surface, const DistanceOptions& 
   tolerance_ = options.tolerance > 0.0 ? options.tolerance : 1e-9 * surfaceScale(surface_);
   // A surface collapsed to the origin has scale 0; any positive tolerance will do there.
   if (!(tolerance_ > 0.0)) tolerance_ = std::numeric_limits<double>::min();
+  // The trees' depth, lowered for all patches alike to keep within kTreePointsBudget: deeper
+  // cells are halved on demand as the same bits (the contract), so only speed depends on it.
+  int depth = options.treeDepth;
+  const auto pointsAt = [&](int levels) {
+    std::size_t points = 0;
+    const std::size_t cells = ((std::size_t{1} << (2 * (levels + 1))) - 1) / 3;
+    for (const BezierPatch& patch : surface_.patches) points += cells * patch.control.size() * (patch.rational() ? 2 : 1);
+    return points;
+  };
+  while (depth > 0 && pointsAt(depth) > kTreePointsBudget) --depth;
   trees_.reserve(surface_.patches.size());
   for (const BezierPatch& patch : surface_.patches) {
-    trees_.push_back(buildTree(patch, options.treeDepth));
+    trees_.push_back(buildTree(patch, depth));
   }
+  buildHierarchy(trees_, nodes_, nodePatches_);
 }
 
 SurfaceDistance::~SurfaceDistance() = default;
@@ -1211,13 +1398,13 @@ SurfaceDistance& SurfaceDistance::operator=(SurfaceDistance&&) noexcept = defaul
 ClosestPoint SurfaceDistance::closest(Vec3 p) const { return closest(p, kInfinity); }
 
 ClosestPoint SurfaceDistance::closest(Vec3 p, double cutoff) const {
-  return search(surface_, trees_, id_, tolerance_, options_.maxCells, p, cutoff);
+  return search(surface_, trees_, nodes_, nodePatches_, id_, tolerance_, options_.maxCells, p, cutoff);
 }
 
 SegmentClearance SurfaceDistance::segmentClearance(Vec3 a, Vec3 b, double clearance,
                                                    std::size_t maxCells) const {
   if (maxCells < 1) throw Error("segment clearance: maxCells must be >= 1");
-  return segmentSearch(trees_, id_, a, b, clearance, maxCells);
+  return segmentSearch(trees_, nodes_, nodePatches_, id_, a, b, clearance, maxCells);
 }
 
 double distanceToSurface(const Surface& surface, Vec3 p, const DistanceOptions& options) {

@@ -392,6 +392,84 @@ TEST(SurfaceDistance, TreeDepthTranslationAndRepetitionAgree) {
   }
 }
 
+// Hundreds of patches (the pieces of trimmed faces, a part of many faces): the search walks
+// the hierarchy of the patches' boxes and lowers its trees' depth past kTreePointsBudget
+// (800 bicubic patches at depth 4 would hold 4.4 M points). Against each patch searched
+// alone (one patch is one leaf: every root cell offered, no hierarchy), the least distance
+// over the patches: the same within the tolerance, its point on the patch it names; a
+// cutoff's bound; and segment clearances: violated when some patch alone violates it,
+// proven when every patch alone proves it.
+TEST(SurfaceDistance, ManyPatchesAgreeWithEachPatchAlone) {
+  std::mt19937_64 rng(2026);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<BezierPatch> patches;
+  for (int i = 0; i < 800; ++i) {
+    // A 20 x 20 grid of places 2.5 apart, two patches each, some overlapping their neighbours.
+    const Vec3 offset{2.5 * (i % 20) + unit(rng), 2.5 * ((i / 20) % 20) + unit(rng), 0.5 * unit(rng)};
+    if (i % 10 == 9) {
+      BezierPatch patch = test::randomRationalPatch(rng, 2, 3);
+      for (Vec3& c : patch.control) c = offset + 3.0 * c;
+      patches.push_back(std::move(patch));
+    } else {
+      patches.push_back(randomPatch(rng, 3, 3, false, offset));
+    }
+  }
+  const Surface surface = surfaceOf(patches);
+  const double tol = 1e-9 * surfaceScale(surface);
+  DistanceOptions options;
+  options.tolerance = tol;
+  const SurfaceDistance engine(surface, options);
+  std::vector<SurfaceDistance> alone;
+  for (const BezierPatch& patch : patches) alone.emplace_back(surfaceOf({patch}), options);
+
+  std::uniform_real_distribution<double> across(-3.0, 53.0), up(-2.0, 3.0), reach(-1.5, 1.5);
+  int violated = 0, proven = 0;
+  for (int i = 0; i < 500; ++i) {
+    const Vec3 p = i % 5 == 4 ? Vec3{across(rng), across(rng), 20.0 * up(rng)} : Vec3{across(rng), across(rng), up(rng)};
+    double least = std::numeric_limits<double>::infinity();
+    for (const SurfaceDistance& one : alone) {
+      const ClosestPoint r = one.closest(p);
+      ASSERT_TRUE(r.converged) << i;
+      least = std::min(least, r.distance);
+    }
+    const ClosestPoint result = engine.closest(p);
+    ASSERT_TRUE(result.converged) << i;
+    EXPECT_NEAR(result.distance, least, tol) << i;
+    EXPECT_LE(result.lowerBound, least + tol) << i;
+    EXPECT_NEAR(norm(point(surface.patches.at(result.patch), result.u, result.v) - result.point), 0.0, 1e-9) << i;
+    EXPECT_NEAR(norm(result.point - p), result.distance, 1e-9) << i;
+    // A cutoff below the distance: proven at least the cutoff, and never above the truth.
+    const ClosestPoint below = engine.closest(p, 0.5 * least);
+    EXPECT_TRUE(below.converged) << i;
+    EXPECT_GE(below.lowerBound, 0.5 * least) << i;
+    EXPECT_LE(below.lowerBound, least + tol) << i;
+
+    // A segment from p, and a clearance about the distance of its ends.
+    const Vec3 b = p + Vec3{reach(rng), reach(rng), reach(rng)};
+    const double clearance = least * (0.6 + 0.6 * unit(rng));
+    bool someViolated = false, allProven = true;
+    for (const SurfaceDistance& one : alone) {
+      const Clearance verdict = one.segmentClearance(p, b, clearance).verdict;
+      someViolated = someViolated || verdict == Clearance::violated;
+      allProven = allProven && verdict == Clearance::proven;
+    }
+    const SegmentClearance segment = engine.segmentClearance(p, b, clearance);
+    if (someViolated) {
+      EXPECT_EQ(segment.verdict, Clearance::violated) << i;
+      ++violated;
+    } else if (allProven) {
+      EXPECT_EQ(segment.verdict, Clearance::proven) << i;
+      ++proven;
+    }
+    if (segment.verdict == Clearance::violated) {
+      EXPECT_LT(segment.distance, clearance) << i;
+    }
+  }
+  // Both verdicts are exercised.
+  EXPECT_GT(violated, 50);
+  EXPECT_GT(proven, 50);
+}
+
 TEST(SurfaceDistance, FreeFunctionsAndErrors) {
   const Surface surface = exampleSurface("paper-1");
   const Vec3 p{1.5, 1.5, 5.0};

@@ -40,7 +40,14 @@
 //         improves on the best so far, a projected Newton iteration on f clamped to
 //         [0, 1]^2 from there. The cell with the smallest lower bound is split in four (de
 //         Casteljau at 1/2 in u and v) until no cell can beat the best point by more than
-//         the tolerance. Each patch's quadtree of cells to `treeDepth` levels is built once,
+//         the tolerance. The patches' boxes are kept in a bounding-volume hierarchy (median
+//         splits along the longest axis, at most kPatchesPerLeaf patches a leaf, in index
+//         order), whose nodes are queued by the same lower bounds as cells: a patch's cells
+//         enter the search only when its leaf's box can beat the best point, so a query near
+//         one region of a part of thousands of patches (a trimmed face's pieces) looks at
+//         O(log N) nodes, not at every patch. A surface of at most kPatchesPerLeaf patches
+//         is one leaf, its patches offered in order as before.
+//         Each patch's quadtree of cells to `treeDepth` levels is built once,
 //         with its boxes (the halving is bezier.hpp's subdivideU then subdivideV at 1/2, bit
 //         for bit, without allocation); the search starts from it and halves its leaves
 //         further on demand. Cells halved below the trees are kept per thread across queries
@@ -72,7 +79,10 @@
 //         allowance cannot be met: the search then stops at kMaxCellDepth halvings or at
 //         maxCells cells and reports converged == false with the bounds it has proven.
 // Complexity: building, O(4^treeDepth (m + 1)(n + 1)) memory and time per patch
-//         (bicubic, depth 4: 341 cells, 130 kB, about 0.1 ms). A query: O(m n (m + n)) per
+//         (bicubic, depth 4: 341 cells, 130 kB, about 0.1 ms), the depth lowered for all
+//         patches alike until their trees hold at most kTreePointsBudget control points in
+//         all (22,862 bicubic pieces of a trimmed part: depth 1, 43 MB, not 3 GB), plus
+//         O(N log N) for the hierarchy. A query: O(m n (m + n)) per
 //         cell; on the paper's surface #1 at distance 0.25, 7.4 cells on average, about 10^5
 //         queries per second of one core (at distance 2, beyond the focal distance in
 //         places: 50 cells, 3 x 10^4 per second). Worst case maxCells cells: at a centre of
@@ -138,11 +148,17 @@ namespace scallop {
 
 namespace detail {
 struct PatchTree;  // one patch's quadtree of sub-patches and their boxes (gouge.cpp)
+struct PatchNode;  // a node of the hierarchy of the patches' boxes (gouge.cpp)
 }  // namespace detail
 
 /// Deepest halving of a cell below the patch: a cell then spans 2^-48 in u and v, and its
 /// corners stay exact binary fractions.
 constexpr int kMaxCellDepth = 48;
+/// Patches per leaf of SurfaceDistance's hierarchy of patch boxes.
+constexpr std::size_t kPatchesPerLeaf = 8;
+/// Control points in all the patches' prebuilt trees (24 bytes each): the trees' depth is
+/// lowered below DistanceOptions::treeDepth past it.
+constexpr std::size_t kTreePointsBudget = std::size_t{1} << 22;
 
 struct DistanceOptions {
   /// Absolute tolerance on the distance (surface units, >= 0); 0 selects 1e-9 x the
@@ -237,6 +253,8 @@ class SurfaceDistance {
   DistanceOptions options_;
   double tolerance_ = 0.0;
   std::vector<detail::PatchTree> trees_;  // one per patch
+  std::vector<detail::PatchNode> nodes_;  // the patches' boxes in a hierarchy; nodes_[0] the root
+  std::vector<std::uint32_t> nodePatches_;  // the patches of the leaves, leaf by leaf
   // Tells this engine's cells apart in the per-thread store of halved cells (gouge.cpp);
   // unique per construction, kept by copies (their trees are the same).
   std::uint64_t id_ = 0;
