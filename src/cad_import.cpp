@@ -76,6 +76,7 @@
 
 #include "cad_file.hpp"
 #include "scallop/error.hpp"
+#include "scallop/face_trim.hpp"
 
 namespace scallop {
 namespace {
@@ -425,58 +426,6 @@ void checkConversion(const Handle(Geom_Surface)& original, const Handle(Geom_BSp
 }
 
 // --- trimmed faces (see the contract's "trimmed faces") ------------------------------------
-
-// A box of the face's parameter plane.
-struct ParameterBox {
-  double u0, u1, v0, v1;
-  bool meets(const ParameterBox& other) const {
-    return u0 <= other.u1 && other.u0 <= u1 && v0 <= other.v1 && other.v0 <= v1;
-  }
-};
-
-// One rational Bezier arc of a trimming curve in the face's parameter plane, in homogeneous
-// coordinates (w u, w v, w), w > 0.
-using TrimArc = std::vector<std::array<double, 3>>;
-
-ParameterBox poleBox(const TrimArc& arc) {
-  ParameterBox box{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
-                   std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
-  for (const auto& p : arc) {
-    const double u = p[0] / p[2], v = p[1] / p[2];
-    box = {std::min(box.u0, u), std::max(box.u1, u), std::min(box.v0, v), std::max(box.v1, v)};
-  }
-  return box;
-}
-
-// Whether the arc may meet the box. false is proven: an arc with positive weights lies in the
-// convex hull of its poles, so in their box, and halves (de Casteljau on the homogeneous
-// poles, exact up to rounding, which the callers' margins cover) lie in theirs. true once a
-// half whose box meets the box is smaller than an eighth of it in both directions, or at
-// depth 40: conservatively "may meet".
-bool mayMeet(const TrimArc& arc, const ParameterBox& box) {
-  const double smallU = (box.u1 - box.u0) / 8.0, smallV = (box.v1 - box.v0) / 8.0;
-  std::vector<std::pair<TrimArc, int>> stack{{arc, 0}};
-  while (!stack.empty()) {
-    auto [poles, depth] = std::move(stack.back());
-    stack.pop_back();
-    const ParameterBox own = poleBox(poles);
-    if (!own.meets(box)) continue;
-    if ((own.u1 - own.u0 <= smallU && own.v1 - own.v0 <= smallV) || depth >= 40) return true;
-    // Halve: the left half's poles are the first points of each de Casteljau level, the
-    // right half's the last (reversed).
-    const std::size_t n = poles.size();
-    TrimArc left(n), right(n);
-    for (std::size_t level = 0; level < n; ++level) {
-      left[level] = poles[0];
-      right[n - 1 - level] = poles[n - 1 - level];
-      for (std::size_t i = 0; i + 1 < n - level; ++i)
-        for (std::size_t c = 0; c < 3; ++c) poles[i][c] = 0.5 * (poles[i][c] + poles[i + 1][c]);
-    }
-    stack.push_back({std::move(left), depth + 1});
-    stack.push_back({std::move(right), depth + 1});
-  }
-  return false;
-}
 
 // The face's trimming curves (every edge's pcurve, seam edges in both orientations) as rational
 // Bezier arcs, exactly: OCCT's conversion of lines, conics, B-spline and Bezier curves is
