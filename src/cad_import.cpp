@@ -18,7 +18,6 @@
 
 #include <fmt/format.h>
 
-#include <BRepClass_FaceClassifier.hxx>
 #include <BRepTools.hxx>
 #include <BRep_Tool.hxx>
 #include <ElSLib.hxx>
@@ -430,8 +429,9 @@ void checkConversion(const Handle(Geom_Surface)& original, const Handle(Geom_BSp
 // The face's trimming curves (every edge's pcurve, seam edges in both orientations) as rational
 // Bezier arcs, exactly: OCCT's conversion of lines, conics, B-spline and Bezier curves is
 // algebraic; any other kind is refused.
-std::vector<TrimArc> trimArcs(const TopoDS_Face& face) {
-  std::vector<TrimArc> arcs;
+FaceTrim trimArcs(const TopoDS_Face& face) {
+  FaceTrim trim;
+  std::vector<TrimArc>& arcs = trim.arcs;
   std::size_t index = 0;
   for (TopExp_Explorer it(face, TopAbs_EDGE); it.More(); it.Next(), ++index) {
     const TopoDS_Edge& edge = TopoDS::Edge(it.Current());
@@ -466,11 +466,13 @@ std::vector<TrimArc> trimArcs(const TopoDS_Face& face) {
                                         p.X(), p.Y(), w)};
         arc.push_back({w * p.X(), w * p.Y(), w});
       }
+      // The loops close when each edge runs as its wire does: a REVERSED edge's pcurve backwards.
+      if (edge.Orientation() == TopAbs_REVERSED) std::reverse(arc.begin(), arc.end());
       arcs.push_back(std::move(arc));
     }
   }
   if (arcs.empty()) throw FaceRefused{CadFaceIssue::trimmed, "is trimmed by no curve"};
-  return arcs;
+  return trim;
 }
 
 // The rectangle of a trimmed face: its pcurves' bounds (BRepTools::UVBounds), within the
@@ -593,20 +595,6 @@ class PieceParameters {
   std::map<double, double> cacheU_, cacheV_;
 };
 
-// Where a face-parameter box lies with respect to the face: boundary when a trimming arc may
-// meet it, else its centre's side by OCCT's classifier (ON: boundary).
-CellPlace classifyBox(const TopoDS_Face& face, const std::vector<TrimArc>& arcs, const ParameterBox& box) {
-  for (const TrimArc& arc : arcs)
-    if (mayMeet(arc, box)) return CellPlace::boundary;
-  const BRepClass_FaceClassifier classifier(face, gp_Pnt2d(0.5 * (box.u0 + box.u1), 0.5 * (box.v0 + box.v1)),
-                                            Precision::PConfusion());
-  switch (classifier.State()) {
-    case TopAbs_IN: return CellPlace::inside;
-    case TopAbs_OUT: return CellPlace::outside;
-    default: return CellPlace::boundary;
-  }
-}
-
 // What facePatches is doing, for the message when OCCT throws.
 struct Stage {
   const char* what = "reading the face";
@@ -619,6 +607,7 @@ struct FacePatches {
   std::vector<PieceRole> roles;
   bool trimmed = false;
   double largestSpreadRad = 0.0;
+  FaceTrim trim;  // a trimmed face's arcs
 };
 
 FacePatches facePatches(const TopoDS_Face& face, Units units, Stage& stage, const CadImportOptions& options,
@@ -699,7 +688,8 @@ FacePatches facePatches(const TopoDS_Face& face, Units units, Stage& stage, cons
     return result;
   }
   stage.what = "following its trimming curves";
-  const std::vector<TrimArc> arcs = trimArcs(face);
+  result.trim = trimArcs(face);
+  const FaceTrim& trim = result.trim;
   const bool converted =
       !basis->IsKind(STANDARD_TYPE(Geom_BSplineSurface)) && !basis->IsKind(STANDARD_TYPE(Geom_BezierSurface));
   TColStd_Array1OfReal knotsU(1, splitter.NbUPatches() + 1), knotsV(1, splitter.NbVPatches() + 1);
@@ -721,7 +711,7 @@ FacePatches facePatches(const TopoDS_Face& face, Units units, Stage& stage, cons
       TrimSplit pieceSplit;
       try {
         pieceSplit = splitTrimmedPatch(
-            patches[index], [&](const ParameterCell& cell) { return classifyBox(face, arcs, parameters.box(cell)); },
+            patches[index], [&](const ParameterCell& cell) { return classifyBox(trim, parameters.box(cell)); },
             split);
       } catch (const Error& error) {
         if (split.maxPieces < options.trimSplit.maxPieces)  // the file's budget ran out, not the patch's
@@ -804,7 +794,10 @@ CadImport convertFaces(const CadFile& transferred, const std::string& path, cons
         result.patchFaces.push_back(index);
         result.patchRoles.push_back(patches.roles[p]);
       }
-      if (patches.trimmed) ++result.trimmedFaces;
+      if (patches.trimmed) {
+        ++result.trimmedFaces;
+        result.faceTrims.emplace(index, std::move(patches.trim));
+      }
       result.largestSpreadRad = std::max(result.largestSpreadRad, patches.largestSpreadRad);
     } catch (const TrimBudgetExceeded& exceeded) {
       const std::string name = detail::cadFaceName(transferred, face, index);

@@ -60,7 +60,10 @@
 //           are refused) is converted exactly to rational Bezier arcs; a cell's box that no
 //           arc's control polygon box meets (arcs subdivided until their boxes are an eighth
 //           of the cell's) lies wholly inside or outside the face, decided at its centre by
-//           OCCT's BRepClass_FaceClassifier; a box that some arc may meet is "boundary".
+//           the parity of the arcs' winding number (face_trim.hpp's classifyBox; each edge's
+//           arcs run as its wire does, so the loops close); a box that some arc may meet, or
+//           whose centre the winding cannot decide, is "boundary". CadImport::faceTrims keeps
+//           the arcs.
 //           CadImport::patchRoles tells the pieces apart; at most maxTrimPieces in all.
 //         - validity: each patch must satisfy surface.hpp's contract (degree <= 20, regular);
 //           a face with a patch that does not is refused with validateSurface's reason.
@@ -83,11 +86,13 @@
 //         its poles, plus surface.hpp's regularity check per patch.
 
 #include <cstddef>
+#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "scallop/face_trim.hpp"
 #include "scallop/surface.hpp"
 #include "scallop/trimmed_patch.hpp"
 
@@ -160,6 +165,9 @@ struct CadImport {
   /// boundary piece may reach beyond the trimming curve by less than its cell).
   std::vector<PieceRole> patchRoles;
   std::size_t trimmedFaces = 0;          ///< faces taken as pieces (acceptTrimmed)
+  /// Per trimmed face (acceptTrimmed), by its index: its trimming arcs in its own parameters,
+  /// as the pieces were classified against them (face_trim.hpp).
+  std::map<std::size_t, FaceTrim> faceTrims;
   double largestSpreadRad = 0.0;         ///< over boundary pieces (trimmed_patch.hpp's spread)
   double seconds = 0.0;                  ///< wall time of the import
 };

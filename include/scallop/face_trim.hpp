@@ -18,9 +18,32 @@
 //         of the face's rectangle).
 // Work:   at most 2^k halves examined for the depth k reached, k <= 40; in practice a few
 //         dozen (an arc's halves away from the box drop out at once).
+//
+// Contract of classifyPoint
+// -------------------------
+// Input:  a face's trim: its arcs forming closed loops in the parameter plane (each edge's
+//         pcurve in the direction its wire runs, seam edges once in each direction; ends of
+//         consecutive arcs may differ by the model's tolerance), and a point p.
+// Output: inside or outside by the parity of the winding number of the loops about p (odd:
+//         inside; so a hole's loop, whichever way it runs, takes p out again), boundary when
+//         p lies on an arc or within rounding of one, or when the arcs' angles about p do not
+//         sum to a multiple of 2 pi within kWindingSlackRad (a gap between the ends of
+//         consecutive arcs that p is close to beside its size).
+// Method: each arc's angle about p, exactly up to rounding: an arc whose poles (as vectors
+//         from p) lie in a wedge narrower than pi lies in it too (convex hull), so its angle
+//         is its end's angle from its start, atan2(a x b, a . b); otherwise it is halved
+//         (de Casteljau on the homogeneous poles), at most kWindingDepth times.
+// Work:   O(n) per arc far from p (n poles); an arc passing near p at distance d halves
+//         O(log(size / d)) times along its length near p.
+//
+// classifyBox: boundary when some arc may meet the box (mayMeet), else its centre's place
+// (a box that no arc meets lies wholly on one side: its centre tells which; a centre the
+// winding cannot decide makes the box boundary).
 
 #include <array>
 #include <vector>
+
+#include "scallop/trimmed_patch.hpp"
 
 namespace scallop {
 
@@ -41,5 +64,25 @@ ParameterBox poleBox(const TrimArc& arc);
 
 /// Whether the arc may meet the box (see the contract: false is proven).
 bool mayMeet(const TrimArc& arc, const ParameterBox& box);
+
+/// A trimmed face's domain: the arcs of its trimming loops (see classifyPoint's contract).
+struct FaceTrim {
+  std::vector<TrimArc> arcs;
+};
+
+/// How far the arcs' angles about a point may sum from a multiple of 2 pi (radians).
+inline constexpr double kWindingSlackRad = 0.1;
+/// Halvings of an arc before a point is taken to lie on it.
+inline constexpr int kWindingDepth = 60;
+
+/// The angle (radians) the arc sweeps about (u, v); NaN when (u, v) lies on it (within
+/// rounding: kWindingDepth halvings did not separate it).
+double sweptAngle(const TrimArc& arc, double u, double v);
+
+/// Where the point (u, v) lies with respect to the face's trim (see the contract).
+CellPlace classifyPoint(const FaceTrim& trim, double u, double v);
+
+/// Where the box lies with respect to the face's trim (see the contract).
+CellPlace classifyBox(const FaceTrim& trim, const ParameterBox& box);
 
 }  // namespace scallop

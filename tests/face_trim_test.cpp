@@ -1,0 +1,278 @@
+// face_trim.hpp: a face's trimming loops as rational arcs, and where points and boxes of the
+// parameter plane lie. The reference written here: each loop sampled densely into a polygon
+// (4,000 points per arc) and the even-odd crossing rule on it, for points farther from the
+// polygon than its chordal error; on thousands of random points against random polygons with
+// weighted vertices, exact circles (rational quadratic arcs), random cubic loops (which may
+// cross themselves), holes running either way, arcs reversed, and gaps between arc ends.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "scallop/face_trim.hpp"
+
+namespace {
+
+using scallop::CellPlace;
+using scallop::FaceTrim;
+using scallop::ParameterBox;
+using scallop::TrimArc;
+
+struct Point {
+  double u, v;
+};
+
+// The arc's point at t (de Casteljau on the homogeneous poles).
+Point evaluate(const TrimArc& arc, double t) {
+  TrimArc p = arc;
+  for (std::size_t level = 1; level < p.size(); ++level)
+    for (std::size_t i = 0; i + level < p.size(); ++i)
+      for (std::size_t c = 0; c < 3; ++c) p[i][c] = (1.0 - t) * p[i][c] + t * p[i + 1][c];
+  return {p[0][0] / p[0][2], p[0][1] / p[0][2]};
+}
+
+TrimArc arcOf(const std::vector<Point>& poles, const std::vector<double>& weights) {
+  TrimArc arc;
+  for (std::size_t i = 0; i < poles.size(); ++i)
+    arc.push_back({weights[i] * poles[i].u, weights[i] * poles[i].v, weights[i]});
+  return arc;
+}
+
+// A circle as four rational quadratic arcs (exact), counter-clockwise or not.
+std::vector<TrimArc> circle(Point centre, double radius, bool clockwise) {
+  std::vector<TrimArc> arcs;
+  const double w = std::sqrt(0.5);
+  for (int q = 0; q < 4; ++q) {
+    const double a = q * std::numbers::pi / 2.0, b = a + std::numbers::pi / 2.0;
+    const Point start{centre.u + radius * std::cos(a), centre.v + radius * std::sin(a)};
+    const Point end{centre.u + radius * std::cos(b), centre.v + radius * std::sin(b)};
+    const Point corner{centre.u + radius * (std::cos(a) + std::cos(b)), centre.v + radius * (std::sin(a) + std::sin(b))};
+    arcs.push_back(arcOf({start, corner, end}, {1.0, w, 1.0}));
+  }
+  if (clockwise) {  // each arc backwards, and the arcs in the reverse order: still one loop
+    std::reverse(arcs.begin(), arcs.end());
+    for (TrimArc& arc : arcs) std::reverse(arc.begin(), arc.end());
+  }
+  return arcs;
+}
+
+// The loops sampled into polygons (each arc 4,000 chords), for the reference.
+struct Reference {
+  std::vector<std::vector<Point>> polygons;  // one per arc; joined in any order the parity holds
+  double chordError = 0.0;
+
+  explicit Reference(const FaceTrim& trim) {
+    for (const TrimArc& arc : trim.arcs) {
+      std::vector<Point> polygon;
+      for (int i = 0; i <= 4000; ++i) polygon.push_back(evaluate(arc, i / 4000.0));
+      polygons.push_back(polygon);
+    }
+  }
+
+  // The even-odd rule on the sampled loops (ray towards +u), and the distance to them. The
+  // sampled arcs meet end to end as the arcs do; a gap between two ends is closed by a chord.
+  bool inside(Point p) const {
+    bool odd = false;
+    const auto cross = [&](Point a, Point b) {
+      if ((a.v > p.v) != (b.v > p.v)) {
+        const double u = a.u + (p.v - a.v) / (b.v - a.v) * (b.u - a.u);
+        if (u > p.u) odd = !odd;
+      }
+    };
+    for (const auto& polygon : polygons)
+      for (std::size_t i = 0; i + 1 < polygon.size(); ++i) cross(polygon[i], polygon[i + 1]);
+    for (std::size_t k = 0; k < polygons.size(); ++k)  // gaps: each arc's end to its successor's start
+      cross(polygons[k].back(), polygons[(k + 1) % polygons.size()].front());
+    return odd;
+  }
+
+  double distance(Point p) const {
+    double least = 1e300;
+    for (const auto& polygon : polygons)
+      for (std::size_t i = 0; i + 1 < polygon.size(); ++i) {
+        const Point a = polygon[i], b = polygon[i + 1];
+        const double du = b.u - a.u, dv = b.v - a.v, length2 = du * du + dv * dv;
+        double t = length2 > 0.0 ? ((p.u - a.u) * du + (p.v - a.v) * dv) / length2 : 0.0;
+        t = std::clamp(t, 0.0, 1.0);
+        least = std::min(least, std::hypot(a.u + t * du - p.u, a.v + t * dv - p.v));
+      }
+    return least;
+  }
+};
+
+// One random trim of the kinds in the header comment. Its loops are listed arc after arc, each
+// loop's arcs in order, so that the reference's chords from each arc's end to the next arc's
+// start close the gaps within a loop; between two closed loops the chord runs from one to
+// the other and back, which changes no parity.
+FaceTrim randomTrim(std::mt19937_64& rng, int kind) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0), weight(0.3, 3.0);
+  FaceTrim trim;
+  const auto add = [&](std::vector<TrimArc> loop) {
+    for (TrimArc& arc : loop) trim.arcs.push_back(std::move(arc));
+  };
+  switch (kind % 5) {
+    case 0: {  // a star-shaped polygon with weighted vertices (the sides stay straight)
+      const int sides = 3 + static_cast<int>(unit(rng) * 30);
+      std::vector<Point> vertices;
+      for (int i = 0; i < sides; ++i) {
+        const double angle = 2.0 * std::numbers::pi * (i + 0.8 * unit(rng)) / sides, r = 0.3 + unit(rng);
+        vertices.push_back({r * std::cos(angle), r * std::sin(angle)});
+      }
+      std::vector<TrimArc> loop;
+      for (int i = 0; i < sides; ++i)
+        loop.push_back(arcOf({vertices[i], vertices[(i + 1) % sides]}, {weight(rng), weight(rng)}));
+      add(loop);
+      break;
+    }
+    case 1:  // a circle
+      add(circle({unit(rng), unit(rng)}, 0.2 + unit(rng), unit(rng) < 0.5));
+      break;
+    case 2: {  // a closed loop of random cubic arcs about the origin, perhaps crossing itself
+      const int count = 2 + static_cast<int>(unit(rng) * 6);
+      std::vector<Point> ends;
+      for (int i = 0; i < count; ++i) {
+        const double angle = 2.0 * std::numbers::pi * i / count;
+        ends.push_back({std::cos(angle), std::sin(angle)});
+      }
+      std::vector<TrimArc> loop;
+      for (int i = 0; i < count; ++i) {
+        const Point a = ends[i], b = ends[(i + 1) % count];
+        const Point c1{a.u + 1.2 * (unit(rng) - 0.5), a.v + 1.2 * (unit(rng) - 0.5)};
+        const Point c2{b.u + 1.2 * (unit(rng) - 0.5), b.v + 1.2 * (unit(rng) - 0.5)};
+        loop.push_back(arcOf({a, c1, c2, b}, {1.0, weight(rng), weight(rng), 1.0}));
+      }
+      add(loop);
+      break;
+    }
+    case 3: {  // a square with a circular hole, either way round
+      const Point s[4] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+      std::vector<TrimArc> loop;
+      for (int i = 0; i < 4; ++i) loop.push_back(arcOf({s[i], s[(i + 1) % 4]}, {1.0, 1.0}));
+      add(loop);
+      add(circle({0.3 * (unit(rng) - 0.5), 0.3 * (unit(rng) - 0.5)}, 0.2 + 0.5 * unit(rng), unit(rng) < 0.5));
+      break;
+    }
+    default: {  // a circle whose arcs' ends stand 1e-10 apart (a model's tolerance)
+      std::vector<TrimArc> loop = circle({0.0, 0.0}, 0.5 + unit(rng), false);
+      for (TrimArc& arc : loop) arc.back()[0] += 1e-10 * arc.back()[2];
+      add(loop);
+      break;
+    }
+  }
+  return trim;
+}
+
+TEST(FaceTrim, PointsAgreeWithTheEvenOddRuleOnDenseSamples) {
+  std::mt19937_64 rng(14);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int decided = 0, near = 0;
+  for (int t = 0; t < 60; ++t) {
+    const FaceTrim trim = randomTrim(rng, t);
+    const Reference reference(trim);
+    for (int i = 0; i < 200; ++i) {
+      const Point p{-2.2 + 4.4 * unit(rng), -2.2 + 4.4 * unit(rng)};
+      const CellPlace place = scallop::classifyPoint(trim, p.u, p.v);
+      // The samples stand within about 1e-7 of the arcs; closer points are left out.
+      if (reference.distance(p) < 1e-6) {
+        ++near;
+        continue;
+      }
+      ASSERT_NE(place, CellPlace::boundary) << "trim " << t << " point " << i << " (" << p.u << ", " << p.v << ")";
+      EXPECT_EQ(place == CellPlace::inside, reference.inside(p))
+          << "trim " << t << " point " << i << " (" << p.u << ", " << p.v << ")";
+      ++decided;
+    }
+  }
+  EXPECT_GT(decided, 11900);
+  EXPECT_LT(near, 100);
+}
+
+// Points very close to a curve (1e-9 .. 1e-4 along its normal, either side) are still told
+// apart; the arcs' own ends are on the curve: boundary.
+TEST(FaceTrim, PointsNearTheCurveAndOnIt) {
+  std::mt19937_64 rng(15);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int t = 0; t < 20; ++t) {
+    const FaceTrim trim = randomTrim(rng, 1 + 3 * (t % 2));  // circles: their inside is known in closed form
+    // The circle's centre and radius from three points of it.
+    const Point a = evaluate(trim.arcs[0], 0.0), b = evaluate(trim.arcs[0], 1.0), c = evaluate(trim.arcs[0], 0.5);
+    const double d = 2.0 * (a.u * (b.v - c.v) + b.u * (c.v - a.v) + c.u * (a.v - b.v));
+    const double a2 = a.u * a.u + a.v * a.v, b2 = b.u * b.u + b.v * b.v, c2 = c.u * c.u + c.v * c.v;
+    const Point centre{(a2 * (b.v - c.v) + b2 * (c.v - a.v) + c2 * (a.v - b.v)) / d,
+                       (a2 * (c.u - b.u) + b2 * (a.u - c.u) + c2 * (b.u - a.u)) / d};
+    const double radius = std::hypot(a.u - centre.u, a.v - centre.v);
+    for (int i = 0; i < 100; ++i) {
+      const double angle = 2.0 * std::numbers::pi * unit(rng);
+      const double offset = std::pow(10.0, -9.0 + 5.0 * unit(rng)) * (unit(rng) < 0.5 ? -1.0 : 1.0);
+      const Point p{centre.u + (radius + offset) * std::cos(angle), centre.v + (radius + offset) * std::sin(angle)};
+      const CellPlace place = scallop::classifyPoint(trim, p.u, p.v);
+      if (t % 2 == 1 && std::abs(offset) < 1e-8) continue;  // the 1e-10 gaps: too close to call
+      EXPECT_EQ(place, offset < 0.0 ? CellPlace::inside : CellPlace::outside) << t << " " << i << " offset " << offset;
+    }
+    for (const TrimArc& arc : trim.arcs) {
+      const Point end = evaluate(arc, 0.0);
+      EXPECT_EQ(scallop::classifyPoint(trim, end.u, end.v), CellPlace::boundary) << t;
+    }
+  }
+}
+
+// Boxes: inside or outside only when every point of the box is (dense samples and the
+// reference), and boundary whenever a sample of the curve lies in the box.
+TEST(FaceTrim, BoxesAreConservative) {
+  std::mt19937_64 rng(16);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int inside = 0, outside = 0, boundary = 0;
+  for (int t = 0; t < 40; ++t) {
+    const FaceTrim trim = randomTrim(rng, t);
+    const Reference reference(trim);
+    for (int i = 0; i < 100; ++i) {
+      const double size = std::pow(10.0, -3.0 + 3.0 * unit(rng));
+      const Point corner{-2.2 + 4.4 * unit(rng), -2.2 + 4.4 * unit(rng)};
+      const ParameterBox box{corner.u, corner.u + size, corner.v, corner.v + size};
+      const CellPlace place = scallop::classifyBox(trim, box);
+      bool curveInBox = false;  // every 4th sample of the curve (1,000 per arc) looked at
+      for (const auto& polygon : reference.polygons)
+        for (std::size_t k = 0; k < polygon.size() && !curveInBox; k += 4)
+          curveInBox = polygon[k].u >= box.u0 && polygon[k].u <= box.u1 && polygon[k].v >= box.v0 && polygon[k].v <= box.v1;
+      if (curveInBox) {
+        EXPECT_EQ(place, CellPlace::boundary) << t << " " << i;
+      }
+      if (place == CellPlace::boundary) {
+        ++boundary;
+        continue;
+      }
+      (place == CellPlace::inside ? inside : outside)++;
+      for (int k = 0; k < 6; ++k) {
+        const Point p{box.u0 + size * unit(rng), box.v0 + size * unit(rng)};
+        if (reference.distance(p) < 1e-6) continue;
+        EXPECT_EQ(reference.inside(p), place == CellPlace::inside) << t << " " << i << " " << k;
+      }
+    }
+  }
+  EXPECT_GT(inside, 200);
+  EXPECT_GT(outside, 200);
+  EXPECT_GT(boundary, 200);
+}
+
+// The angle an arc sweeps: a circle's four quarters sweep pi / 2 each about its centre, and a
+// full turn about any point inside; an arc sweeps nothing about a far point in line with it.
+TEST(FaceTrim, SweptAnglesOfACircle) {
+  const std::vector<TrimArc> arcs = circle({0.25, -0.5}, 2.0, false);
+  for (const TrimArc& arc : arcs) EXPECT_NEAR(scallop::sweptAngle(arc, 0.25, -0.5), std::numbers::pi / 2.0, 1e-14);
+  double total = 0.0;
+  for (const TrimArc& arc : arcs) total += scallop::sweptAngle(arc, 1.5, 0.7);
+  EXPECT_NEAR(total, 2.0 * std::numbers::pi, 1e-13);
+  total = 0.0;
+  for (const TrimArc& arc : arcs) total += scallop::sweptAngle(arc, 5.0, 0.0);
+  EXPECT_NEAR(total, 0.0, 1e-13);
+  const auto& start = arcs[1].front();  // the arc's start: on it
+  EXPECT_TRUE(std::isnan(scallop::sweptAngle(arcs[1], start[0] / start[2], start[1] / start[2])));
+}
+
+}  // namespace
