@@ -115,6 +115,9 @@ void runPaths(const PathsOptions& options) {
   if (options.strategy == "raster" && options.normal != "auto")
     throw CLI::ValidationError("paths", "--normal is for --strategy contour");
   if (isStlSource(options.surface.input)) {
+    if (options.surface.exactTrims)
+      throw Error(fmt::format("{}: --exact-trims is for STEP and IGES parts; an STL file is a mesh",
+                              options.surface.input));
     if (options.tessellate || !options.deflection.empty())
       throw Error(fmt::format("{}: --tessellate and --deflection are for STEP and IGES parts; an STL file is a mesh "
                               "already",
@@ -125,7 +128,7 @@ void runPaths(const PathsOptions& options) {
   }
   if (!options.units.empty() || options.dropZeroArea)
     throw Error("--units and --drop-zero-area are for STL meshes (a .stl file); a surface's units are in its file");
-  const CadRoute route = cadRoute(options.surface, options.tessellate, options.deflection, exactRationalFaces());
+  const CadRoute route = cadRoute(options.surface, options.tessellate, options.deflection, exactRationalFaces(options.surface));
   if (route.tessellate) {
     MeshRasterRequest request = meshRequest(options);
     request.quiet = options.jsonPath.empty() && options.gcodePath.empty();  // JSON on stdout: stderr quiet too
@@ -232,6 +235,7 @@ void addPathsCommand(CLI::App& app) {
   paths->add_option("--svg", options->svgPath, "write a picture of the surface, the sections and the paths")
       ->type_name("OUT");
   addStlOptions(*paths, options->units, options->dropZeroArea);
+  addExactTrimsOption(*paths, options->surface);
   paths->add_flag("--tessellate", options->tessellate,
                   "STEP/IGES: raster on the part's tessellation, the proofs kept 1.5 times the measured deviation "
                   "farther (parts with trimmed faces are cut so without it)");

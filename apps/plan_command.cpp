@@ -276,6 +276,9 @@ void runPlan(const PlanOptions& options) {
   if (!options.spacing.empty() && !options.scallopHeight.empty())
     throw CLI::ValidationError("plan", "give at most one of --spacing and --scallop-height");
   if (isStlSource(options.surface.input)) {
+    if (options.surface.exactTrims)
+      throw Error(fmt::format("{}: --exact-trims is for STEP and IGES parts; an STL file is a mesh",
+                              options.surface.input));
     if (options.tessellate || !options.deflection.empty())
       throw Error(fmt::format("{}: --tessellate and --deflection are for STEP and IGES parts; an STL file is a mesh "
                               "already",
@@ -290,7 +293,7 @@ void runPlan(const PlanOptions& options) {
   if (!options.units.empty() || options.dropZeroArea)
     throw Error("--units and --drop-zero-area are for STL meshes (a .stl file); a surface's units are in its file");
   // Every face exact: the surface route below. Otherwise (or asked) the tessellation.
-  const CadRoute route = cadRoute(options.surface, options.tessellate, options.deflection, exactRationalFaces());
+  const CadRoute route = cadRoute(options.surface, options.tessellate, options.deflection, exactRationalFaces(options.surface));
   if (route.tessellate) {
     rejectMeshOptions(options, "a tessellated part");
     MeshJob job = tessellatedJob(*route.part, route.exact, meshRequest(options), options.deflection);
@@ -472,6 +475,7 @@ void addPlanCommand(CLI::App& app) {
                  "reach (by default, with a scallop height and adaptive spacing, up to two rounds of "
                  "them, each simulated again)");
   addStlOptions(*plan, options->units, options->dropZeroArea);
+  addExactTrimsOption(*plan, options->surface);
   plan->add_flag("--tessellate", options->tessellate,
                  "STEP/IGES: cut the part through its tessellation (raster on the mesh, proofs kept 1.5 times the "
                  "measured deviation farther, the cut simulated on the exact faces) even when every face could be "

@@ -142,6 +142,12 @@ CadRoute cadRoute(const SurfaceSource& source, bool tessellate, const std::strin
   const bool cad = !source.input.empty() && source.input != "-" && cadFormatOf(source.input).has_value();
   if (!cad && (tessellate || !deflection.empty()))
     throw Error("--tessellate and --deflection are for STEP and IGES parts (.step, .stp, .iges, .igs)");
+  if (!cad && source.exactTrims)
+    throw Error(fmt::format("{}: --exact-trims is for STEP and IGES parts (.step, .stp, .iges, .igs)",
+                            sourceBaseName(source)));
+  if (source.exactTrims && (tessellate || source.skipFaces))
+    throw Error(fmt::format("{}: --exact-trims takes trimmed faces exactly; not with {}", source.input,
+                            tessellate ? "--tessellate" : "--skip-faces"));
   if (cad && source.skipFaces && tessellate)
     throw Error(fmt::format("{}: --skip-faces takes only the faces imported exactly, --tessellate all of them "
                             "through the mesh: give one",
@@ -160,9 +166,20 @@ CadRoute cadRoute(const SurfaceSource& source, bool tessellate, const std::strin
   return route;
 }
 
-CadImportOptions exactRationalFaces() {
+void addExactTrimsOption(CLI::App& command, SurfaceSource& source) {
+  command.add_flag("--exact-trims", source.exactTrims,
+                   "STEP/IGES: take trimmed faces of B-spline and Bezier surfaces (and planes) exactly, with their "
+                   "trimming curves, instead of cutting the part through its tessellation (a part with another trimmed "
+                   "face is still tessellated)");
+}
+
+CadImportOptions exactRationalFaces(const SurfaceSource& source) {
   CadImportOptions options;
   options.acceptRational = true;
+  // Trimmed faces of B-spline and Bezier surfaces (and planes) exactly, with their trims;
+  // others (cylinders, cones, ... trimmed) leave the part to the tessellation.
+  options.acceptTrimmed = source.exactTrims;
+  options.keepTrims = source.exactTrims;
   return options;
 }
 

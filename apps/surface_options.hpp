@@ -27,7 +27,12 @@ struct SurfaceSource {
   std::string patches;
   bool skipFaces = false;
   bool acceptRational = true;  // STEP/IGES rational faces as rational patches (every command takes them)
+  bool exactTrims = false;     // --exact-trims: trimmed B-spline faces kept whole with their trims
 };
+
+/// Adds --exact-trims (plan, paths, verify): STEP/IGES trimmed faces of B-spline and Bezier
+/// surfaces (and planes) taken exactly, with their trims (cad_import.hpp's keepTrims).
+void addExactTrimsOption(CLI::App& command, SurfaceSource& source);
 
 /// Adds the SURFACE positional and --example NAME (checked against the built-in names,
 /// mutually exclusive), --patches LIST and --skip-faces to `command`.
@@ -71,7 +76,7 @@ CadRoute cadRoute(const SurfaceSource& source, bool tessellate, const std::strin
 /// The exact route's options for plan, paths and verify: rational faces as rational patches
 /// (sections, distances and the simulated cut take them); trimmed faces refused (their tool
 /// paths would not stop at the trimming curves: the part goes through its tessellation).
-CadImportOptions exactRationalFaces();
+CadImportOptions exactRationalFaces(const SurfaceSource& source);
 
 /// How messages and reports name the surface: "example NAME", "<stdin>" or the path, followed
 /// by " (patches LIST)" when some are selected.

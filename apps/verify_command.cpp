@@ -44,6 +44,7 @@ struct VerifyOptions {
   std::string svgPath;
   bool failOnGouge = false;
   bool skipFaces = false;  // --skip-faces: a STEP or IGES file's unsupported faces
+  bool exactTrims = false;  // --exact-trims: trimmed B-spline faces exactly
   std::string units;          // --units in|mm: an STL mesh's (STL has none)
   bool dropZeroArea = false;  // --drop-zero-area: an STL mesh's zero-area triangles
 };
@@ -59,12 +60,15 @@ int runVerify(const VerifyOptions& options) {
                                              : "with --example give only PROGRAM");
   if (expected == 2) source.input = options.files[0];
   source.skipFaces = options.skipFaces;
+  source.exactTrims = options.exactTrims;
   const std::string programPath = options.files.back();
 
   SimulationOptions simulation;
   simulation.toolRadius = parsePositive(options.radius, "tool radius", "a positive length");
   // The design: a triangle mesh (.stl) or a surface of Bezier patches.
   const bool mesh = expected == 2 && isStlSource(source.input);
+  if (mesh && options.exactTrims)
+    throw Error(fmt::format("{}: --exact-trims is for STEP and IGES parts; an STL file is a mesh", source.input));
   if (mesh && (!options.patches.empty() || options.skipFaces))
     throw Error(fmt::format("{}: --patches and --skip-faces select a surface's patches or faces; not for a mesh",
                             source.input));
@@ -80,7 +84,7 @@ int runVerify(const VerifyOptions& options) {
   if (mesh) {
     stl = loadStlMesh(source.input, options.units, options.dropZeroArea);
   } else {
-    route = cadRoute(source, false, "", exactRationalFaces());
+    route = cadRoute(source, false, "", exactRationalFaces(source));
     if (route->tessellate) {
       part = &*route->part;
       if (!options.patches.empty())
@@ -188,6 +192,9 @@ void addVerifyCommand(CLI::App& app, int& exitStatus) {
       ->type_name("NAME");
   verify->add_option("--patches", options->patches, "keep only these patches of the surface, e.g. 4 or 4-7,12")
       ->type_name("LIST");
+  verify->add_flag("--exact-trims", options->exactTrims,
+                   "STEP/IGES: judge trimmed faces of B-spline and Bezier surfaces (and planes) on the exact Bezier "
+                   "patches with their trimming curves, instead of through OpenCASCADE");
   verify->add_flag("--skip-faces", options->skipFaces,
                    "STEP/IGES: leave out the faces that cannot be imported exactly, as plan --skip-faces");
   verify->add_option("--radius", options->radius, "ball radius R, in the surface's units")->required()->type_name("R");

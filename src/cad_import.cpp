@@ -527,6 +527,24 @@ class PieceParameters {
     }
   }
 
+  // The patch's trim (face_trim.hpp's PatchTrim) when its parameters map affinely onto the
+  // face's: checked at the middle and quarter points (1e-12 of the span; the identity, up to
+  // the period, for B-spline and Bezier faces; planes too); nullopt otherwise.
+  std::optional<PatchTrim> affineTrim(std::shared_ptr<const FaceTrim> face) {
+    const auto atS = [&](double s) { return faceU(knotU0_ + (reversed_ ? 1.0 - s : s) * (knotU1_ - knotU0_)); };
+    const auto atT = [&](double t) { return faceV(knotV0_ + t * (knotV1_ - knotV0_)); };
+    PatchTrim trim;
+    trim.u0 = atS(0.0), trim.u1 = atS(1.0), trim.v0 = atT(0.0), trim.v1 = atT(1.0);
+    for (const double f : {0.25, 0.5, 0.75}) {
+      if (!(std::abs(atS(f) - (trim.u0 + f * (trim.u1 - trim.u0))) <= 1e-12 * std::abs(trim.u1 - trim.u0)) ||
+          !(std::abs(atT(f) - (trim.v0 + f * (trim.v1 - trim.v0))) <= 1e-12 * std::abs(trim.v1 - trim.v0)))
+        return std::nullopt;
+    }
+    trim.face = std::move(face);
+    trim.margin = std::max(marginU_, marginV_);
+    return trim;
+  }
+
   // The face-parameter box that the patch cell maps onto, widened by the margins.
   ParameterBox box(const ParameterCell& cell) {
     const double sA = reversed_ ? 1.0 - cell.u1 : cell.u0, sB = reversed_ ? 1.0 - cell.u0 : cell.u1;
@@ -608,6 +626,7 @@ struct FacePatches {
   bool trimmed = false;
   double largestSpreadRad = 0.0;
   FaceTrim trim;  // a trimmed face's arcs
+  std::vector<PatchTrim> trims;  // keepTrims: per patch
 };
 
 FacePatches facePatches(const TopoDS_Face& face, Units units, Stage& stage, const CadImportOptions& options,
@@ -690,6 +709,8 @@ FacePatches facePatches(const TopoDS_Face& face, Units units, Stage& stage, cons
   stage.what = "following its trimming curves";
   result.trim = trimArcs(face);
   const FaceTrim& trim = result.trim;
+  const auto shared = std::make_shared<const FaceTrim>(trim);
+  std::vector<BezierPatch> whole;  // keepTrims: the patches that meet the face, with their trims
   const bool converted =
       !basis->IsKind(STANDARD_TYPE(Geom_BSplineSurface)) && !basis->IsKind(STANDARD_TYPE(Geom_BezierSurface));
   TColStd_Array1OfReal knotsU(1, splitter.NbUPatches() + 1), knotsV(1, splitter.NbVPatches() + 1);
@@ -722,6 +743,18 @@ FacePatches facePatches(const TopoDS_Face& face, Units units, Stage& stage, cons
       }
       trimBudget -= std::min(trimBudget, weight * pieceSplit.pieces.size());
       result.largestSpreadRad = std::max(result.largestSpreadRad, pieceSplit.largestSpreadRad);
+      if (options.keepTrims && !pieceSplit.pieces.empty()) {
+        std::optional<PatchTrim> patchTrim = parameters.affineTrim(shared);
+        if (!patchTrim)
+          throw FaceRefused{CadFaceIssue::trimmed,
+                            fmt::format("is {} (piece {}), whose patches' parameters are not an affine image of the "
+                                        "face's: its trim is followed by pieces only (not kept exactly)",
+                                        surfaceKind(basis), index)};
+        // A patch wholly inside its face needs no trim.
+        const bool inside = pieceSplit.pieces.size() == 1 && pieceSplit.insidePieces == 1;
+        whole.push_back(patches[index]);
+        result.trims.push_back(inside ? PatchTrim{} : *patchTrim);
+      }
       for (TrimmedPiece& piece : pieceSplit.pieces) {
         result.patches.push_back(std::move(piece.patch));
         result.roles.push_back(piece.role);
@@ -730,6 +763,10 @@ FacePatches facePatches(const TopoDS_Face& face, Units units, Stage& stage, cons
   if (result.patches.empty())
     throw FaceRefused{CadFaceIssue::trimmed, "lies outside its own trimming curves (no piece of it is inside)"};
   validate(result.patches, "trimmed piece");
+  if (options.keepTrims) {  // the pieces were for the checks: the patches are kept whole, trimmed
+    result.patches = std::move(whole);
+    result.roles.assign(result.patches.size(), PieceRole::inside);
+  }
   return result;
 }
 
@@ -793,6 +830,13 @@ CadImport convertFaces(const CadFile& transferred, const std::string& path, cons
         result.surface.patches.push_back(std::move(patches.patches[p]));
         result.patchFaces.push_back(index);
         result.patchRoles.push_back(patches.roles[p]);
+        if (!patches.trims.empty()) {
+          // The first trimmed patch: every earlier patch is untrimmed.
+          result.surface.trims.resize(result.surface.patches.size() - 1);
+          result.surface.trims.push_back(patches.trims[p]);
+        } else if (result.surface.trimmed()) {
+          result.surface.trims.emplace_back();
+        }
       }
       if (patches.trimmed) {
         ++result.trimmedFaces;

@@ -43,6 +43,7 @@ Extent sampleExtent(const Surface& surface, const Vec3& m) {
     for (int i = 0; i <= kGrid; ++i)
       for (int j = 0; j <= kGrid; ++j) {
         const double u = double(i) / kGrid, v = double(j) / kGrid;
+        if (!surfaceKeepsPoint(surface, p, u, v)) continue;
         const double s = dot(m, point(surface.patches[p], u, v));
         e.lo = std::min(e.lo, s);
         e.hi = std::max(e.hi, s);
@@ -169,6 +170,7 @@ CentreSamples centreSamples(const Surface& surface, const Vec3& m, double radius
     for (int i = 0; i <= grid; ++i)
       for (int j = 0; j <= grid; ++j) {
         const double u = double(i) / grid, v = double(j) / grid;
+        if (!surfaceKeepsPoint(surface, p, u, v)) continue;
         const Vec3 q = point(patch, u, v);
         const Vec3 n = upwardNormal(surface, p, u, v);
         CrossGeometry g = crossGeometry(surface, SectionPoint{q, p, u, v}, m);

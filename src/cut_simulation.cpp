@@ -268,6 +268,7 @@ double secondsSince(std::chrono::steady_clock::time_point start) {
 struct SurfaceHit {
   double z = 0.0;
   double normalZ = 0.0;  // |n_z| of the unit normal there
+  double u = 0.0, v = 0.0;
 };
 
 std::optional<SurfaceHit> solveHeight(const BezierPatch& patch, double u0, double u1, double v0, double v1,
@@ -279,7 +280,7 @@ std::optional<SurfaceHit> solveHeight(const BezierPatch& patch, double u0, doubl
     if (std::hypot(fx, fy) <= tolerance) {
       const Vec3 n = cross(ru, rv);
       const double length = norm(n);
-      return SurfaceHit{r.z, length > 0.0 ? std::abs(n.z) / length : 0.0};
+      return SurfaceHit{r.z, length > 0.0 ? std::abs(n.z) / length : 0.0, u, v};
     }
     const double det = ru.x * rv.y - rv.x * ru.y;
     if (det == 0.0 || !std::isfinite(det)) return std::nullopt;
@@ -315,11 +316,19 @@ struct DesignPatch {
   const BezierPatch& patch;
   Bernstein2 jacobian;  // x_u y_v - x_v y_u
   double tolerance;
+  const PatchTrim* trim = nullptr;  // a trimmed patch's: only its face's points are design
 };
 
 void designCell(const DesignPatch& design, double u0, double u1, double v0, double v1, int depth, HeightGrid& grid,
                 std::vector<double>* normalZ) {
   const BezierPatch& patch = design.patch;
+  // A trimmed patch's cell outside its face holds no design; inside it, no hit needs a test.
+  DesignPatch inner = design;
+  if (design.trim != nullptr) {
+    const CellPlace place = classifyCell(*design.trim, ParameterCell{u0, u1, v0, v1});
+    if (place == CellPlace::outside) return;
+    if (place == CellPlace::inside) inner.trim = nullptr;
+  }
   const double tolerance = design.tolerance;
   const BezierPatch piece = restrictTo(patch, u0, u1, v0, v1);
   double xlo = kInf, xhi = -kInf, ylo = kInf, yhi = -kInf;
@@ -340,10 +349,10 @@ void designCell(const DesignPatch& design, double u0, double u1, double v0, doub
   // proportional to the grid points even where a vertical wall projects onto a grid line.
   if ((count > kCellPoints || (!oneSheet && count > kFoldCellPoints)) && depth < kDesignMaxDepth) {
     const double um = 0.5 * (u0 + u1), vm = 0.5 * (v0 + v1);
-    designCell(design, u0, um, v0, vm, depth + 1, grid, normalZ);
-    designCell(design, um, u1, v0, vm, depth + 1, grid, normalZ);
-    designCell(design, u0, um, vm, v1, depth + 1, grid, normalZ);
-    designCell(design, um, u1, vm, v1, depth + 1, grid, normalZ);
+    designCell(inner, u0, um, v0, vm, depth + 1, grid, normalZ);
+    designCell(inner, um, u1, v0, vm, depth + 1, grid, normalZ);
+    designCell(inner, u0, um, vm, v1, depth + 1, grid, normalZ);
+    designCell(inner, um, u1, vm, v1, depth + 1, grid, normalZ);
     return;
   }
   // On a fold cell (left at the depth limit) Newton also starts from the four corners'
@@ -357,6 +366,7 @@ void designCell(const DesignPatch& design, double u0, double u1, double v0, doub
         const auto hit = solveHeight(patch, u0, u1, v0, v1, u0 + start.x * (u1 - u0), v0 + start.y * (v1 - v0), p.x,
                                      p.y, tolerance);
         if (!hit) continue;
+        if (inner.trim != nullptr && !keepsPoint(*inner.trim, hit->u, hit->v)) continue;
         const std::size_t index = j * grid.columns + i;
         if (hit->z > grid.z[index]) {
           grid.z[index] = hit->z;
@@ -538,8 +548,11 @@ void designHeights(const Surface& surface, HeightGrid& grid, std::vector<double>
   std::fill(grid.z.begin(), grid.z.end(), -kInf);
   if (normalZ) normalZ->assign(grid.z.size(), 0.0);
   const double tolerance = 1e-12 * std::max(surfaceScale(surface), 1e-300);
-  for (const BezierPatch& patch : surface.patches)
-    designCell(DesignPatch{patch, jacobianSign(patch), tolerance}, 0.0, 1.0, 0.0, 1.0, 0, grid, normalZ);
+  for (std::size_t i = 0; i < surface.patches.size(); ++i) {
+    const PatchTrim* trim = surface.trimmed() && surface.trims[i].trimmed() ? &surface.trims[i] : nullptr;
+    designCell(DesignPatch{surface.patches[i], jacobianSign(surface.patches[i]), tolerance, trim}, 0.0, 1.0, 0.0, 1.0,
+               0, grid, normalZ);
+  }
 }
 
 namespace {

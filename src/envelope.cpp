@@ -154,7 +154,9 @@ class Lifter {
     if (contactKnown_) {
       const BezierPatch& patch = distance_.surface().patches[contactPatch_];
       const Contact contact = localDropContact(patch, contactU_, contactV_, p.x, p.y);
-      if (contact.z > p.z && verticalClear(p.x, p.y, contact.z)) {
+      // A trimmed patch's contact outside its face is no contact.
+      if (contact.z > p.z && surfaceKeepsPoint(distance_.surface(), contactPatch_, contact.u, contact.v) &&
+          verticalClear(p.x, p.y, contact.z)) {
         contactU_ = contact.u, contactV_ = contact.v;
         return {p.x, p.y, contact.z};
       }
@@ -168,7 +170,7 @@ class Lifter {
       const std::size_t patchIndex = seedPatch_;
       const BezierPatch& patch = distance_.surface().patches[patchIndex];
       const Contact contact = localDropContact(patch, seedU_, seedV_, p.x, p.y);
-      if (!(contact.z > low)) break;
+      if (!(contact.z > low) || !surfaceKeepsPoint(distance_.surface(), patchIndex, contact.u, contact.v)) break;
       low = contact.z;
       if (verticalClear(p.x, p.y, contact.z)) {
         contactKnown_ = true;

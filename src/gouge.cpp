@@ -15,6 +15,7 @@
 #include <numbers>
 #include <string>
 #include <thread>
+#include <unordered_map>
 #include <vector>
 
 #if defined(__SSE2__)
@@ -579,6 +580,7 @@ struct Cell {
   std::size_t net = 0;
   double u0 = 0.0;
   double v0 = 0.0;
+  bool inFace = false;  // a trimmed patch's cell known to lie in its face (no more classifying)
 };
 
 struct ByLowerBound {
@@ -699,10 +701,11 @@ template <class Consider>
   const int m = tree.degreeU;
   const int n = tree.degreeV;
   const double h = cellSide(cell.depth);
-  if (fresh & 1u) consider(net[0], cell.patch, cell.u0, cell.v0);
-  if (fresh & 2u) consider(net[n], cell.patch, cell.u0, cell.v0 + h);
-  if (fresh & 4u) consider(net[m * (n + 1)], cell.patch, cell.u0 + h, cell.v0);
-  if (fresh & 8u) consider(net[m * (n + 1) + n], cell.patch, cell.u0 + h, cell.v0 + h);
+  // A cell known to lie in its face (or of an untrimmed patch) needs no test of its corners.
+  if (fresh & 1u) consider(net[0], cell.patch, cell.u0, cell.v0, cell.inFace);
+  if (fresh & 2u) consider(net[n], cell.patch, cell.u0, cell.v0 + h, cell.inFace);
+  if (fresh & 4u) consider(net[m * (n + 1)], cell.patch, cell.u0 + h, cell.v0, cell.inFace);
+  if (fresh & 8u) consider(net[m * (n + 1) + n], cell.patch, cell.u0 + h, cell.v0 + h, cell.inFace);
   return cell.inTree ? tree.boxes[static_cast<std::size_t>(cell.depth)][cell.net] : store.boxes[cell.box];
 }
 
@@ -868,7 +871,7 @@ void offerQuarters(const Cell& cell, const PatchTree& tree, CellStore& store, co
     for (std::size_t a = 0; a < 2; ++a) {
       for (std::size_t b = 0; b < 2; ++b) {
         offer(Cell{0.0, cell.patch, cell.depth + 1, true, 0, (2 * iu + a) * (2 * side) + (2 * iv + b),
-                   cell.u0 + static_cast<double>(a) * half, cell.v0 + static_cast<double>(b) * half},
+                   cell.u0 + static_cast<double>(a) * half, cell.v0 + static_cast<double>(b) * half, cell.inFace},
               kFresh[a][b]);
       }
     }
@@ -886,7 +889,7 @@ void offerQuarters(const Cell& cell, const PatchTree& tree, CellStore& store, co
       const std::size_t k = 2 * a + b;
       offer(Cell{0.0, cell.patch, cell.depth + 1, false, box + static_cast<std::uint32_t>(k),
                  first + k * tree.stride, cell.u0 + static_cast<double>(a) * half,
-                 cell.v0 + static_cast<double>(b) * half},
+                 cell.v0 + static_cast<double>(b) * half, cell.inFace},
             kFresh[a][b]);
     }
   }
@@ -977,6 +980,56 @@ PatchTree buildTree(const BezierPatch& patch, int depth) {
 }
 
 // The branch and bound of the contract.
+// Cells of trimmed patches classified, kept per thread across queries (keyed by the
+// SurfaceDistance's id, patch, depth and position): consecutive queries classify the same
+// cells, and classifying one halves the face's arcs down to its size. Emptied past 2^20.
+struct TrimCellKey {
+  std::uint64_t id = 0, iu = 0, iv = 0;
+  std::uint32_t patch = 0;
+  int depth = 0;
+  bool operator==(const TrimCellKey&) const = default;
+};
+
+struct TrimCellHash {
+  std::size_t operator()(const TrimCellKey& k) const {
+    std::uint64_t h = k.iu * 0x9E3779B97F4A7C15ULL ^ (k.iv + 0x632BE59BD9B4E019ULL) * 0xC2B2AE3D27D4EB4FULL;
+    h ^= (k.id << 40 ^ static_cast<std::uint64_t>(k.patch) << 8 ^ static_cast<std::uint64_t>(k.depth)) *
+         0x165667B19E3779F9ULL;
+    return static_cast<std::size_t>(h ^ (h >> 29));
+  }
+};
+
+// A trimmed patch's cell (trims non-null and the patch trimmed, the cell not known inside):
+// false when it lies outside the face (dropped), else marks it when it lies inside.
+bool classifyForTrim(const std::vector<PatchTrim>* trims, std::uint64_t id, Cell& cell) {
+  if (cell.inFace) return true;
+  if (trims == nullptr || !(*trims)[cell.patch].trimmed()) {
+    cell.inFace = true;  // all of an untrimmed patch is surface
+    return true;
+  }
+  thread_local std::unordered_map<TrimCellKey, CellPlace, TrimCellHash> known;
+  const double h = cellSide(cell.depth);
+  const double cells = cellSide(-cell.depth);
+  const TrimCellKey key{id, static_cast<std::uint64_t>(cell.u0 * cells), static_cast<std::uint64_t>(cell.v0 * cells),
+                        cell.patch, cell.depth};
+  CellPlace place;
+  if (const auto found = known.find(key); found != known.end()) {
+    place = found->second;
+  } else {
+    place = classifyCell((*trims)[cell.patch], ParameterCell{cell.u0, cell.u0 + h, cell.v0, cell.v0 + h});
+    if (known.size() >= (std::size_t{1} << 20)) known.clear();
+    known.emplace(key, place);
+  }
+  if (place == CellPlace::outside) return false;
+  cell.inFace = place == CellPlace::inside;
+  return true;
+}
+
+// Whether a surface point of the patch counts (a trimmed patch's points outside its face do not).
+bool inFace(const std::vector<PatchTrim>* trims, std::size_t patch, double u, double v) {
+  return trims == nullptr || keepsPoint((*trims)[patch], u, v);
+}
+
 ClosestPoint search(const Surface& surface, const std::vector<PatchTree>& trees, const std::vector<PatchNode>& nodes,
                     const std::vector<std::uint32_t>& nodePatches, std::uint64_t id, double tolerance,
                     std::size_t maxCells, Vec3 p, double cutoff) {
@@ -996,15 +1049,23 @@ ClosestPoint search(const Surface& surface, const std::vector<PatchTree>& trees,
   std::size_t cells = 0;
   const double pScale = maxAbs(p);
   const auto level = [&] { return std::min(best.distance - tolerance, cutoff); };
-  const auto consider = [&](Vec3 q, std::size_t patch, double u, double v) {
+  const std::vector<PatchTrim>* trims = surface.trimmed() ? &surface.trims : nullptr;
+  bool trimResolved = false;  // a cell on a trimming curve was left at kTrimCellDepth
+  // Points of cells on a trimming curve are not offered as corners (`known` false there): the
+  // inside cells beside them, as fine, offer theirs; centres and Newton points are tested.
+  const auto consider = [&](Vec3 q, std::size_t patch, double u, double v, bool known) {
     const double d = norm(q - p);
-    if (d < best.distance) best = {d, patch, u, v, q};
+    if (d < best.distance && known) best = {d, patch, u, v, q};
+  };
+  const auto considerTested = [&](Vec3 q, std::size_t patch, double u, double v) {
+    consider(q, patch, u, v, inFace(trims, patch, u, v));
   };
   // Bounds a new cell: its corners are surface points (upper bounds); then its lower bound,
   // the axis-aligned box first (cheap, precomputed in the tree) and the separating plane
   // only if the cell survives that; then queued or set aside.
   const auto offer = [&](Cell cell, unsigned fresh) {
     ++cells;
+    if (!classifyForTrim(trims, id, cell)) return;
     const PatchTree& tree = trees[cell.patch];
     const Vec3* net = cellNet(tree, cell, store);
     const Box box = cornersAndBox(tree, cell, net, fresh, store, consider);
@@ -1047,8 +1108,12 @@ ClosestPoint search(const Surface& surface, const std::vector<PatchTree>& trees,
     const Jet jet = jetAt(patch, uc, vc);
     if (norm(jet.r - p) < best.distance) {
       const Candidate polished = newton(patch, cell.patch, p, uc, vc, jet);
-      consider(jet.r, cell.patch, uc, vc);
-      consider(polished.point, cell.patch, polished.u, polished.v);
+      if (cell.inFace) {
+        consider(jet.r, cell.patch, uc, vc, true);
+      } else {
+        considerTested(jet.r, cell.patch, uc, vc);
+      }
+      considerTested(polished.point, cell.patch, polished.u, polished.v);  // Newton may leave the cell
     }
     if (cell.lower >= level()) {
       setAside = std::min(setAside, cell.lower);
@@ -1066,6 +1131,12 @@ ClosestPoint search(const Surface& surface, const std::vector<PatchTree>& trees,
       setAside = std::min(setAside, cell.lower);
       continue;
     }
+    if (cell.depth >= kTrimCellDepth && trims != nullptr && !cell.inFace && (*trims)[cell.patch].trimmed()) {
+      // On a trimming curve and as fine as the trim is followed: its bound stands.
+      setAside = std::min(setAside, cell.lower);
+      trimResolved = true;
+      continue;
+    }
     if (cells >= maxCells) {
       lowerBound = cell.lower;
       break;
@@ -1080,7 +1151,9 @@ ClosestPoint search(const Surface& surface, const std::vector<PatchTree>& trees,
   result.v = best.v;
   result.point = best.point;
   result.lowerBound = std::max(0.0, std::min({lowerBound, walk.waiting(), setAside, best.distance}));
-  result.converged = best.distance - result.lowerBound <= tolerance || result.lowerBound >= cutoff;
+  // Beside a trimming curve the bound is as fine as the cells there (see the contract).
+  const double reach = trimResolved ? tolerance + kTrimCellReach * (surfaceScale(surface) + pScale) : tolerance;
+  result.converged = best.distance - result.lowerBound <= reach || result.lowerBound >= cutoff;
   result.cells = cells;
   return result;
 }
@@ -1136,8 +1209,8 @@ double separatingPlaneSegmentDistance(const Vec3* net, int m, int n, const Query
 }
 
 SegmentClearance segmentSearch(const std::vector<PatchTree>& trees, const std::vector<PatchNode>& nodes,
-                               const std::vector<std::uint32_t>& nodePatches, std::uint64_t id, Vec3 a, Vec3 b,
-                               double clearance, std::size_t maxCells) {
+                               const std::vector<std::uint32_t>& nodePatches, const std::vector<PatchTrim>* trims,
+                               std::uint64_t id, Vec3 a, Vec3 b, double clearance, std::size_t maxCells) {
   if (!isFinite(a) || !isFinite(b)) {
     throw Error(fmt::format("segment clearance: the segment ({}, {}, {}) - ({}, {}, {}) is not "
                             "finite", a.x, a.y, a.z, b.x, b.y, b.z));
@@ -1152,8 +1225,12 @@ SegmentClearance segmentSearch(const std::vector<PatchTree>& trees, const std::v
   const QuerySegment segment(a, b);
   const double pScale = std::max(maxAbs(a), maxAbs(b));
   // A surface point nearer than the clearance refutes it; the nearest seen is kept.
+  bool trimUnresolved = false;  // a cell on a trimming curve left at kTrimCellDepth within the clearance
   bool violated = false;
-  const auto consider = [&](Vec3 q, std::uint32_t patch, double u, double v) {
+  // Corners of cells on a trimming curve are not tested (`known` false): the inside cells
+  // beside them, as fine, offer theirs.
+  const auto consider = [&](Vec3 q, std::uint32_t patch, double u, double v, bool known) {
+    if (!known) return;
     const double d = norm(q - nearestOnSegment(segment, q));
     if (d < result.distance) {
       result.distance = d;
@@ -1166,6 +1243,7 @@ SegmentClearance segmentSearch(const std::vector<PatchTree>& trees, const std::v
   };
   const auto offer = [&](Cell cell, unsigned fresh) {
     ++result.cells;
+    if (!classifyForTrim(trims, id, cell)) return;
     const PatchTree& tree = trees[cell.patch];
     const Vec3* net = cellNet(tree, cell, store);
     const Box box = cornersAndBox(tree, cell, net, fresh, store, consider);
@@ -1203,9 +1281,13 @@ SegmentClearance segmentSearch(const std::vector<PatchTree>& trees, const std::v
       result.verdict = Clearance::undecided;
       return result;
     }
+    if (cell.depth >= kTrimCellDepth && trims != nullptr && !cell.inFace && (*trims)[cell.patch].trimmed()) {
+      trimUnresolved = true;  // on a trimming curve, as fine as the trim is followed: not proven
+      continue;
+    }
     offerQuarters(cell, tree, store, offer);
   }
-  result.verdict = violated ? Clearance::violated : Clearance::proven;
+  result.verdict = violated ? Clearance::violated : trimUnresolved ? Clearance::undecided : Clearance::proven;
   return result;
 }
 
@@ -1404,7 +1486,8 @@ ClosestPoint SurfaceDistance::closest(Vec3 p, double cutoff) const {
 SegmentClearance SurfaceDistance::segmentClearance(Vec3 a, Vec3 b, double clearance,
                                                    std::size_t maxCells) const {
   if (maxCells < 1) throw Error("segment clearance: maxCells must be >= 1");
-  return segmentSearch(trees_, nodes_, nodePatches_, id_, a, b, clearance, maxCells);
+  return segmentSearch(trees_, nodes_, nodePatches_, surface_.trimmed() ? &surface_.trims : nullptr, id_, a, b,
+                       clearance, maxCells);
 }
 
 double distanceToSurface(const Surface& surface, Vec3 p, const DistanceOptions& options) {

@@ -1390,6 +1390,8 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
                             0.1 * 180.0 / std::numbers::pi, tol * 180.0 / std::numbers::pi));
   }
   validateSurface(surface);
+  // Trimmed faces: their pieces' normals hold the faces' (a certified lower bound of alpha*).
+  if (surface.trimmed()) return optimalSlicing(trimmedPieces(surface), options);
   // The polish and the certificate work on pieces without corners where q vanishes (the
   // polish's heights divide by |q|); the Gauss map and the coverage proof resolve them
   // themselves, naming the source patches in their errors.

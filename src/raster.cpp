@@ -367,6 +367,7 @@ class AngleObjective {
       for (int i = 0; i <= kAngleGrid; ++i)
         for (int j = 0; j <= kAngleGrid; ++j) {
           const double u = double(i) / kAngleGrid, v = double(j) / kAngleGrid;
+          if (!surfaceKeepsPoint(surface, p, u, v)) continue;
           const Vec3 n = unitNormal(surface.patches[p], u, v);
           samples_.push_back({n.x, n.y, u, v});
         }

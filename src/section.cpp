@@ -329,6 +329,64 @@ class DisjointSets {
 // Joins pieces whose ends meet into maximal curves: a graph whose nodes are the clustered
 // ends and whose edges are the pieces; curves run between nodes of degree != 2, and what
 // remains are cycles (closed loops).
+// --- trimmed patches (surface.hpp's trims) ------------------------------------------------
+
+// The point of the section nearest (u, v) along f's gradient in the parameter square: a few
+// Newton steps on f(u, v) = n . r(u, v) - d from a point within the chordal tolerance of the
+// curve (on a rational patch r = X / w; its zeros are the plane's).
+SectionPoint onSection(const BezierPatch& patch, std::size_t index, Vec3 n, double d, double u, double v) {
+  for (int iteration = 0; iteration < 8; ++iteration) {
+    const Vec3 r = point(patch, u, v);
+    const double f = dot(n, r) - d;
+    const double fu = dot(n, derivativeU(patch, u, v)), fv = dot(n, derivativeV(patch, u, v));
+    const double g2 = fu * fu + fv * fv;
+    if (!(g2 > 0.0) || f == 0.0) break;
+    u = std::clamp(u - f * fu / g2, 0.0, 1.0);
+    v = std::clamp(v - f * fv / g2, 0.0, 1.0);
+  }
+  return {point(patch, u, v), index, u, v};
+}
+
+// The pieces of `piece` (on one trimmed patch) whose points lie in the patch's face: runs of
+// kept vertices, each ended where the curve crosses a trimming curve. The crossing between a
+// kept and a dropped vertex is found by bisection on the chord between them in (u, v), each
+// point brought back onto the section (onSection) before it is classified: 48 halvings.
+void clipPiece(const Piece& piece, const BezierPatch& patch, const PatchTrim& trim, Vec3 n, double d,
+               std::vector<Piece>& out) {
+  std::vector<bool> keep(piece.size());
+  for (std::size_t i = 0; i < piece.size(); ++i) keep[i] = keepsPoint(trim, piece[i].u, piece[i].v);
+  const auto crossing = [&](const SectionPoint& kept, const SectionPoint& dropped) {
+    double in = 0.0, beyond = 1.0;  // along the chord from the kept vertex
+    SectionPoint best = kept;
+    for (int halving = 0; halving < 48; ++halving) {
+      const double mid = 0.5 * (in + beyond);
+      const SectionPoint p = onSection(patch, kept.patch, n, d, kept.u + mid * (dropped.u - kept.u),
+                                       kept.v + mid * (dropped.v - kept.v));
+      if (keepsPoint(trim, p.u, p.v)) {
+        in = mid;
+        best = p;
+      } else {
+        beyond = mid;
+      }
+    }
+    return best;
+  };
+  Piece current;
+  for (std::size_t i = 0; i < piece.size(); ++i) {
+    if (keep[i]) {
+      if (current.empty() && i > 0) current.push_back(crossing(piece[i], piece[i - 1]));
+      current.push_back(piece[i]);
+      continue;
+    }
+    if (!current.empty()) {
+      current.push_back(crossing(piece[i - 1], piece[i]));
+      out.push_back(std::move(current));
+      current.clear();
+    }
+  }
+  if (current.size() >= 2) out.push_back(std::move(current));
+}
+
 void joinPieces(std::vector<Piece> pieces, double joinTolerance, PlaneSection& out) {
   const std::size_t count = pieces.size();
   if (count == 0) return;
@@ -420,7 +478,19 @@ PlaneSection planeSection(const Surface& surface, const Vec3& normal, double off
   std::vector<Piece> pieces;
   for (std::size_t i = 0; i < surface.patches.size(); ++i) {
     PatchSection section(surface.patches[i], i, n, d);
-    sectionPatch(section, chordalTolerance, pieces, out.touchPoints, out.cells);
+    if (!surface.trimmed() || !surface.trims[i].trimmed()) {
+      sectionPatch(section, chordalTolerance, pieces, out.touchPoints, out.cells);
+      continue;
+    }
+    // A trimmed patch: its pieces clipped at the trimming curves, its touch points kept
+    // only inside its face.
+    if (classifyCell(surface.trims[i], ParameterCell{}) == CellPlace::outside) continue;
+    std::vector<Piece> own;
+    std::vector<SectionPoint> touches;
+    sectionPatch(section, chordalTolerance, own, touches, out.cells);
+    for (const Piece& piece : own) clipPiece(piece, surface.patches[i], surface.trims[i], n, d, pieces);
+    for (const SectionPoint& touch : touches)
+      if (keepsPoint(surface.trims[i], touch.u, touch.v)) out.touchPoints.push_back(touch);
   }
   const double scale = std::max(surfaceScale(surface), 1e-300);
   joinPieces(std::move(pieces), kJoinTolerance * scale, out);

@@ -556,7 +556,7 @@ namespace {
 // Validation of a patch in memory (degrees, sizes, finiteness, regularity)
 // ---------------------------------------------------------------------------------------
 
-void validatePatch(const BezierPatch& patch, std::size_t index) {
+void validatePatch(const BezierPatch& patch, std::size_t index, bool regularity = true) {
   const std::string where = patchPath(index);
   for (const auto& [degree, direction] :
        {std::pair{patch.degreeU, "u (the first)"}, std::pair{patch.degreeV, "v (the second)"}}) {
@@ -614,13 +614,14 @@ void validatePatch(const BezierPatch& patch, std::size_t index) {
                             "curvature polynomials neither overflow nor underflow (check the units)",
                             where, scale, kMinPatchScale, kMaxPatchScale));
   }
-  PatchRegularity regularity;
+  if (!regularity) return;  // a trimmed patch: regular where its face is (surface.hpp's trims)
+  PatchRegularity verdict;
   try {
-    regularity = checkPatchRegularity(patch);
+    verdict = checkPatchRegularity(patch);
   } catch (const Error& error) {
     throw Error(fmt::format("{}: {}", where, error.what()));
   }
-  switch (regularity.verdict) {
+  switch (verdict.verdict) {
     case RegularityVerdict::regular:
       return;
     case RegularityVerdict::singular:
@@ -628,9 +629,9 @@ void validatePatch(const BezierPatch& patch, std::size_t index) {
           "{}: degenerate patch: r_u x r_v vanishes at (u, v) = ({}, {}) (|r_u x r_v| / scale^2 = "
           "{:g} <= {:g}, scale = largest |coordinate| = {:g}), so the unit normal is undefined "
           "there{}",
-          where, regularity.u, regularity.v, regularity.relativeNormalLength, regularity.threshold,
+          where, verdict.u, verdict.v, verdict.relativeNormalLength, verdict.threshold,
           patchScale(patch),
-          (regularity.u == 0.0 || regularity.u == 1.0) && (regularity.v == 0.0 || regularity.v == 1.0)
+          (verdict.u == 0.0 || verdict.u == 1.0) && (verdict.v == 0.0 || verdict.v == 1.0)
               ? " (at a corner it may vanish only to first order, its direction having a limit "
                 "along every ray into the patch)"
               : ""));
@@ -639,7 +640,7 @@ void validatePatch(const BezierPatch& patch, std::size_t index) {
           "{}: degenerate patch: could not prove r_u x r_v != 0 near (u, v) = ({}, {}) "
           "(|r_u x r_v| / scale^2 = {:g} there, after {} quadtree cells); the unit normal is "
           "unreliable or undefined nearby",
-          where, regularity.u, regularity.v, regularity.relativeNormalLength, regularity.cells));
+          where, verdict.u, verdict.v, verdict.relativeNormalLength, verdict.cells));
   }
 }
 
@@ -900,7 +901,20 @@ void validateSurface(const Surface& surface, const std::string& sourceName) {
 
 void validateSurface(const Surface& surface) {
   if (surface.patches.empty()) throw Error("patches: no patches; a surface needs at least one");
-  for (std::size_t i = 0; i < surface.patches.size(); ++i) validatePatch(surface.patches[i], i);
+  if (surface.trimmed() && surface.trims.size() != surface.patches.size())
+    throw Error(fmt::format("trims: {} for {} patches; one per patch or none", surface.trims.size(),
+                            surface.patches.size()));
+  for (std::size_t i = 0; i < surface.patches.size(); ++i) {
+    const bool trimmed = surface.trimmed() && surface.trims[i].trimmed();
+    if (trimmed) {
+      const PatchTrim& trim = surface.trims[i];
+      if (!std::isfinite(trim.u0) || !std::isfinite(trim.u1) || !std::isfinite(trim.v0) || !std::isfinite(trim.v1) ||
+          trim.u0 == trim.u1 || trim.v0 == trim.v1 || !(trim.margin >= 0.0) || !std::isfinite(trim.margin))
+        throw Error(fmt::format("{}: its trim maps [0, 1]^2 onto [{}, {}] x [{}, {}] (margin {}): not a rectangle",
+                                patchPath(i), trim.u0, trim.u1, trim.v0, trim.v1, trim.margin));
+    }
+    validatePatch(surface.patches[i], i, !trimmed);
+  }
 }
 
 Surface parseSurface(std::string_view json, const std::string& sourceName, SurfaceCheck check) {

@@ -308,6 +308,7 @@ Surface selectPatches(const Surface& surface, std::span<const std::size_t> indic
                               i, surface.patches.size()));
     }
     selected.patches.push_back(surface.patches[i]);
+    if (surface.trimmed()) selected.trims.push_back(surface.trims[i]);  // a trimmed patch keeps its trim
   }
   return selected;
 }

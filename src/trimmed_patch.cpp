@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "scallop/error.hpp"
+#include "scallop/surface.hpp"
 
 namespace scallop {
 namespace {
@@ -111,6 +112,22 @@ TrimSplit splitTrimmedPatch(const BezierPatch& patch, const CellClassifier& clas
       queue.push_back({child, current.depth + 1});
   }
   return split;
+}
+
+Surface trimmedPieces(const Surface& surface, const TrimSplitOptions& options) {
+  Surface pieces;
+  pieces.units = surface.units;
+  for (std::size_t i = 0; i < surface.patches.size(); ++i) {
+    if (!surface.trimmed() || !surface.trims[i].trimmed()) {
+      pieces.patches.push_back(surface.patches[i]);
+      continue;
+    }
+    const PatchTrim& trim = surface.trims[i];
+    TrimSplit split = splitTrimmedPatch(
+        surface.patches[i], [&](const ParameterCell& cell) { return classifyCell(trim, cell); }, options);
+    for (TrimmedPiece& piece : split.pieces) pieces.patches.push_back(std::move(piece.patch));
+  }
+  return pieces;
 }
 
 }  // namespace scallop

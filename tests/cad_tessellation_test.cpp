@@ -50,6 +50,7 @@
 #include "scallop/cut_simulation.hpp"
 #include "scallop/error.hpp"
 #include "scallop/gcode_reader.hpp"
+#include "scallop/gouge.hpp"
 #include "scallop/mesh_slicing.hpp"
 #include "scallop/optimal_slicing.hpp"
 #include "scallop/surface_io.hpp"
@@ -676,6 +677,53 @@ class CadTessellationCli : public scallop::test::CliFixture {
   }
 };
 
+// A trimmed B-spline face taken exactly (surface.hpp's trims): paper-1's patch trimmed to a
+// disk. Both strategies plan it on the face alone: the simulated cut (on the trimmed face)
+// finds no gouge and scallops within H, and OCCT's exact distance from the ball centres to
+// the face (BRepExtrema, which honours the trim) is never below R: an independent judge. And
+// the trim is what the paths followed: some centres come nearer than R to the untrimmed
+// patch (where it goes on beyond the disk), which a path over the whole patch never does.
+TEST_F(CadTessellationCli, PlanCutsATrimmedBSplineFaceExactlyOnTheFaceAlone) {
+  const Surface paper = exampleFile("paper-1");
+  const TopoDS_Shape face = paperDiskFace(paper);
+  writeStep(face, workDir_ / "disk.step", "INCH");
+  const double radius = 0.25, height = 0.002;
+  for (const std::string strategy : {"contour", "raster"}) {
+    SCOPED_TRACE(strategy);
+    const scallop::test::RunResult plan = run("plan disk.step --exact-trims --strategy " + strategy +
+                                              " --tool-radius 0.25 --scallop-height 0.002 --out out");
+    ASSERT_EQ(plan.exitCode, 0) << plan.err;
+    EXPECT_EQ(plan.err.find("cannot be machined exactly"), std::string::npos) << plan.err;
+    const auto report = nlohmann::json::parse(scallop::test::readFile(workDir_ / "out" / "report.json"));
+    EXPECT_FALSE(report.contains("tessellation"));
+    const auto& v = report["verification"];
+    std::printf("[          ] trimmed disk face, %s: gouge %.3g, scallop max %.6f (H %.3f)\n", strategy.c_str(),
+                v["max_gouge"].get<double>(), v["max_scallop"].get<double>(), height);
+    EXPECT_LE(v["max_gouge"].get<double>(), v["gouge_tolerance"].get<double>());
+    EXPECT_LE(v["max_scallop"].get<double>(), height);
+    // OCCT's distance from the centres (inches in the program, millimetres in OCCT) to the face.
+    const scallop::GcodeProgram program = scallop::readGcodeProgram((workDir_ / "out" / "toolpath.ngc").string());
+    const std::vector<scallop::SweptMove> moves = scallop::sweptMoves(program, radius);
+    const scallop::SurfaceDistance untrimmed(paper);
+    double least = kInf;
+    std::size_t checked = 0, nearerThanRToTheWholePatch = 0;
+    for (std::size_t i = 0; i < moves.size(); i += std::max<std::size_t>(1, moves.size() / 1500)) {
+      if (moves[i].rapid) continue;
+      if (untrimmed.closest(moves[i].end).distance < radius - 1e-3) ++nearerThanRToTheWholePatch;
+      const Vec3 c = 25.4 * moves[i].end;
+      BRepExtrema_DistShapeShape distance(BRepBuilderAPI_MakeVertex(gp_Pnt(c.x, c.y, c.z)).Vertex(), face);
+      ASSERT_TRUE(distance.IsDone());
+      least = std::min(least, distance.Value() / 25.4);
+      ++checked;
+    }
+    EXPECT_GT(checked, 1000u);
+    EXPECT_GE(least, radius - 1e-4);  // the gouge tolerance: the G-code's rounding, 1e-4 in
+    EXPECT_LE(least, radius + 1e-3);  // and the ball does touch the face
+    EXPECT_GT(nearerThanRToTheWholePatch, 0u);
+    fs::remove_all(workDir_ / "out");
+  }
+}
+
 TEST_F(CadTessellationCli, PlanCutsATrimmedRationalPartThroughItsTessellationWithoutGouging) {
   const TopoDS_Shape block = pocketBlock();
   writeStep(block, workDir_ / "pocket.step", "MM");
@@ -747,6 +795,40 @@ TEST_F(CadTessellationCli, PlanAndVerifyOpenCascadesSampleStepAndIgesParts) {
             " --stock-allowance 0.25 --fail-on-gouge");
     EXPECT_EQ(verify.exitCode, 0) << sample.file << ": " << verify.err;
     fs::remove_all(workDir_ / "out");
+  }
+}
+
+// bearing.iges with --exact-trims: its 55 trimmed B-spline faces taken exactly, with their
+// trims. The scallops stay within H (through its tessellation they reach 8.5 H: the clearance
+// its model's tolerance asks exceeds H), and OCCT's distance from the ball centres to the
+// part is never below R by more than the G-code's rounding (1e-4 mm, on steep walls);
+// `verify` judges the program on the exact faces through OpenCASCADE (without the flag) and
+// on the trimmed patches (with it).
+TEST_F(CadTessellationCli, ExactTrimsCutOpenCascadesBearingWithinH) {
+  const std::string path = kOcctSamples + "/iges/bearing.iges";
+  if (!fs::exists(path)) GTEST_FAIL() << path << " is missing: Debian's occt-misc package installs it";
+  const scallop::test::RunResult plan =
+      run("plan " + path + " --exact-trims --tool-radius 0.004 --scallop-height 0.0008 --out out --quiet");
+  ASSERT_EQ(plan.exitCode, 0) << plan.err;
+  const auto report = nlohmann::json::parse(scallop::test::readFile(workDir_ / "out" / "report.json"));
+  EXPECT_FALSE(report.contains("tessellation"));
+  EXPECT_LE(report["verification"]["max_gouge"].get<double>(), 0.0025);
+  EXPECT_LE(report["verification"]["max_scallop"].get<double>(), 0.0008);
+  scallop::test::quietOcct();
+  const std::string saved = Interface_Static::CVal("read.iges.bspline.continuity");
+  Interface_Static::SetCVal("read.iges.bspline.continuity", "0");
+  IGESControl_Reader reader;
+  ASSERT_EQ(reader.ReadFile(path.c_str()), IFSelect_RetDone);
+  reader.TransferRoots();
+  Interface_Static::SetCVal("read.iges.bspline.continuity", saved.c_str());
+  const double least = leastCentreDistance(reader.OneShape(), workDir_ / "out" / "toolpath.ngc", 0.004, 600);
+  std::printf("[          ] bearing.iges --exact-trims: scallop max %.6f mm, least centre distance %.6f mm (R 0.004)\n",
+              report["verification"]["max_scallop"].get<double>(), least);
+  EXPECT_GE(least, 0.004 - 1e-4);
+  for (const std::string flag : {"", " --exact-trims"}) {
+    const scallop::test::RunResult verify = run("verify " + path + " out/toolpath.ngc --radius 0.004 --scallop-height "
+                                                "0.0008 --stock-allowance 0.25 --fail-on-gouge" + flag);
+    EXPECT_EQ(verify.exitCode, 0) << flag << ": " << verify.err;
   }
 }
 

@@ -123,6 +123,15 @@ struct CadImportOptions {
   /// `scallop orient`, whose Gauss map then sees only the face's normals (see the contract's
   /// "trimmed faces"). The other computations take untrimmed faces only.
   bool acceptTrimmed = false;
+  /// With acceptTrimmed: a trimmed face's patches that meet it are kept whole, each with its
+  /// trim (surface.hpp's trims: the face's arcs and the affine map of its parameters), instead
+  /// of as pieces; for `plan`, `paths` and `verify`, whose sections, distances and simulated
+  /// cut then take exactly the face's part. A face whose patches' parameters do not map
+  /// affinely onto the face's (cylinders, cones, spheres, tori, revolutions: the angle is
+  /// not a rational function of the B-spline's parameter) is refused as "trimmed". The
+  /// pieces are still made, for the budget and to check the patches are regular where the
+  /// face is.
+  bool keepTrims = false;
   /// How finely boundary pieces follow the trimming curves (per patch).
   TrimSplitOptions trimSplit{};
   /// Budget of pieces over all trimmed faces of the file, a rational piece counting

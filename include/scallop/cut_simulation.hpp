@@ -259,7 +259,10 @@ inline constexpr std::uint32_t kNoDesignTriangle = 0xffffffffu;
 std::vector<std::uint32_t> designTriangles(const Mesh& mesh, const HeightGrid& grid);
 
 /// The visible height of `surface` at every point of `grid` (see the contract); `normalZ`,
-/// if given, receives |n_z| of the unit normal there (0 off the surface).
+/// if given, receives |n_z| of the unit normal there (0 off the surface). A trimmed patch
+/// (surface.hpp's trims) counts only inside its face: its cells outside the face are skipped
+/// (face_trim.hpp's classifyCell) and a hit in a cell on a trimming curve is kept only where
+/// keepsPoint holds.
 void designHeights(const Surface& surface, HeightGrid& grid, std::vector<double>* normalZ = nullptr);
 
 /// The (move, grid point) pairs in the moves' boxes grown by R: what the sweep may evaluate.

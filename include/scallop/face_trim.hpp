@@ -41,6 +41,8 @@
 // winding cannot decide makes the box boundary).
 
 #include <array>
+#include <cstddef>
+#include <memory>
 #include <vector>
 
 #include "scallop/trimmed_patch.hpp"
@@ -55,6 +57,9 @@ struct ParameterBox {
   }
 };
 
+/// The most poles an arc may have (OCCT's curves are of degree 25 at most).
+inline constexpr std::size_t kMaxTrimPoles = 32;
+
 /// One rational Bezier arc of a trimming curve in a face's parameter plane: its poles in
 /// homogeneous coordinates (w u, w v, w), w > 0, from the arc's start to its end.
 using TrimArc = std::vector<std::array<double, 3>>;
@@ -62,7 +67,8 @@ using TrimArc = std::vector<std::array<double, 3>>;
 /// The box of the arc's poles (u = wu / w, v = wv / w).
 ParameterBox poleBox(const TrimArc& arc);
 
-/// Whether the arc may meet the box (see the contract: false is proven).
+/// Whether the arc may meet the box (see the contract: false is proven). Throws
+/// scallop::Error for an arc of no poles or more than kMaxTrimPoles.
 bool mayMeet(const TrimArc& arc, const ParameterBox& box);
 
 /// A trimmed face's domain: the arcs of its trimming loops (see classifyPoint's contract).
@@ -84,5 +90,31 @@ CellPlace classifyPoint(const FaceTrim& trim, double u, double v);
 
 /// Where the box lies with respect to the face's trim (see the contract).
 CellPlace classifyBox(const FaceTrim& trim, const ParameterBox& box);
+
+/// A Bezier patch of a trimmed face: the face's trim, shared by its patches, and the affine
+/// map from the patch's parameters (s, t) in [0, 1]^2 to the face's,
+///   u = u0 + s (u1 - u0),  v = v0 + t (v1 - v0)
+/// (u1 < u0 where the patch runs against the face's u, as a REVERSED face's patches do).
+/// Exact for the patches of B-spline and Bezier faces (a patch is a knot span of the face's
+/// B-spline, whose parameters are the face's). Without a face the patch is not trimmed.
+/// The patch is the part of its square whose image lies in the face (classifyPoint: inside,
+/// or on a trimming curve).
+struct PatchTrim {
+  std::shared_ptr<const FaceTrim> face;
+  double u0 = 0.0, u1 = 1.0, v0 = 0.0, v1 = 1.0;
+  /// Boxes are widened by this in the face's parameters before they are classified: the
+  /// rounding of the map and of the arcs' halving (cad_import.cpp: 1e-8 of the face's
+  /// rectangle).
+  double margin = 0.0;
+  bool trimmed() const { return face != nullptr; }
+};
+
+/// Where the cell of the patch's square lies with respect to its face (classifyBox of the
+/// cell's image widened by the margin); inside for a patch that is not trimmed.
+CellPlace classifyCell(const PatchTrim& trim, const ParameterCell& cell);
+
+/// Whether the point (s, t) of the patch's square belongs to the patch's part of its face:
+/// inside or on a trimming curve (classifyPoint's boundary); true for an untrimmed patch.
+bool keepsPoint(const PatchTrim& trim, double s, double t);
 
 }  // namespace scallop

@@ -56,6 +56,12 @@
 //         consecutive queries in one region (the drop envelope's proofs along a pass) reuse
 //         their nets and boxes instead of halving again. They are computed as the search
 //         would compute them, so every result is the same, bit for bit, whatever is kept.
+// Trimmed: a trimmed patch (surface.hpp's trims) counts only where its face is. Its cells
+//         are classified against the face's trimming arcs (face_trim.hpp's classifyCell,
+//         kept per thread): outside, dropped; inside, kept with no more classifying; on a
+//         trimming curve, split like any cell but to kTrimCellDepth at most, their lower
+//         bounds (of the whole cell) standing there. Upper bounds are points of the face
+//         only (keepsPoint on every corner, centre and Newton point).
 // Rational: a rational patch's cells keep their Euclidean control points (the cell lies in
 //         their convex hull, as the weights are positive) and weights; halving works on the
 //         homogeneous points w p and the weights, and divides back. Bounds 1 and 2 hold as
@@ -154,6 +160,16 @@ struct PatchNode;  // a node of the hierarchy of the patches' boxes (gouge.cpp)
 /// Deepest halving of a cell below the patch: a cell then spans 2^-48 in u and v, and its
 /// corners stay exact binary fractions.
 constexpr int kMaxCellDepth = 48;
+/// A trimmed patch's cells on its trimming curves are split to this depth at most (cells of
+/// 2^-18 of the patch): their lower bounds then stand, so distances beside a trimming curve
+/// are resolved to about kTrimCellReach of the surface's scale (a closest point converges
+/// within tolerance + that; a segment clearance a cell there would decide is undecided).
+/// Why not deeper: where the face's nearest point lies on a trimming curve, the cells whose
+/// bounds (of the whole cell, the outside part included) stay below it number about
+/// h^-1/2 at side h (measured on paper-1 trimmed to a disk: depth 26 took 125 ms a query).
+constexpr int kTrimCellDepth = 18;
+constexpr double kTrimCellReach = 4.0 / (1 << 18);
+
 /// Patches per leaf of SurfaceDistance's hierarchy of patch boxes.
 constexpr std::size_t kPatchesPerLeaf = 8;
 /// Control points in all the patches' prebuilt trees (24 bytes each): the trees' depth is

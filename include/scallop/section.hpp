@@ -37,6 +37,13 @@
 //         at its centre (a touch point with no crossings is reported in `touchPoints`). Roots
 //         on a cell edge come from the whole iso-parameter line, computed once, so two cells
 //         sharing an edge agree on its crossings bit for bit.
+// Trimmed: a trimmed patch (surface.hpp's trims) gives only the parts of its pieces inside
+//         its face: each traced piece is cut where its vertices change side (face_trim.hpp's
+//         keepsPoint: inside or on a trimming curve), the crossing found by 48 halvings of
+//         the chord in (u, v) between the two vertices, each point brought back onto the
+//         section by Newton steps along f's gradient, so a curve's end lies on the section
+//         and within about 2^-48 of the chord from the trimming curve. Touch points outside
+//         the face are dropped. A patch whose square lies outside its face is skipped.
 // Complexity: O(c (mn)^2) for c quadtree cells, plus O(1) evaluations per traced vertex
 //         (each a 1-D safeguarded Newton solve); c grows like the number of section pieces
 //         and the log of the inverse distance to tangency.

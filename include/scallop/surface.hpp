@@ -82,6 +82,7 @@
 #include <vector>
 
 #include "scallop/bezier.hpp"
+#include "scallop/face_trim.hpp"
 
 namespace scallop {
 
@@ -100,6 +101,14 @@ std::string_view unitsName(Units units);
 struct Surface {
   Units units = Units::inch;
   std::vector<BezierPatch> patches;
+  /// Empty when no patch is trimmed; else one per patch (face_trim.hpp's PatchTrim, without
+  /// a face for an untrimmed patch). Trimmed patches come from STEP and IGES faces
+  /// (cad_import.hpp's keepTrims); the JSON form has none. A trimmed patch must be regular
+  /// where its face is (its pieces are checked where the trim is made, cad_import.cpp), so
+  /// validateSurface checks its form only. Sections, distances, the simulated cut's design
+  /// and the Gauss map (through trimmed_patch.hpp's pieces) take only the face's part.
+  std::vector<PatchTrim> trims{};
+  bool trimmed() const { return !trims.empty(); }
 };
 
 /// Largest degree accepted in either direction. It bounds the cost of the regularity check,
@@ -222,6 +231,21 @@ std::vector<PatchPiece> cornerPieces(const BezierPatch& patch, std::size_t sourc
 /// direction field on the closed patch (the Gauss map, the coverage proof, the optimal
 /// slicing's polish and certificate) works on these pieces.
 Surface cornerResolved(const Surface& surface, std::vector<std::size_t>* sources = nullptr);
+
+/// Whether the point (u, v) of patch `patch` belongs to the surface: always for an untrimmed
+/// patch, inside its face or on a trimming curve for a trimmed one (face_trim.hpp's
+/// keepsPoint). Samplers of patches skip the points it refuses.
+inline bool surfaceKeepsPoint(const Surface& surface, std::size_t patch, double u, double v) {
+  return !surface.trimmed() || keepsPoint(surface.trims[patch], u, v);
+}
+
+/// A trimmed surface's patches as pieces that follow their faces (trimmed_patch.hpp's
+/// splitTrimmedPatch against each patch's trim, classifyCell): inside and boundary pieces, so
+/// their normals hold every normal of the faces (a superset within the pieces' spread); an
+/// untrimmed patch as it is. The result has no trims. For the Gauss map and the optimal
+/// slicing (a certified lower bound of alpha* over the faces). Throws scallop::Error past
+/// the options' budget of pieces, per patch.
+Surface trimmedPieces(const Surface& surface, const TrimSplitOptions& options = {});
 
 /// The largest |coordinate| over all control points (0 for no patches): the length scale
 /// for tolerances.
