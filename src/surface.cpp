@@ -938,6 +938,8 @@ Surface parseSurface(std::string_view json, const std::string& sourceName, Surfa
 }
 
 std::string surfaceToJson(const Surface& surface) {
+  if (surface.trimmed())
+    throw Error("surfaceToJson: a trimmed surface's trims (STEP/IGES trimming curves) have no JSON form");
   std::string out =
       fmt::format("{{\n  \"units\": \"{}\",\n  \"patches\": [", unitsName(surface.units));
   for (std::size_t i = 0; i < surface.patches.size(); ++i) {

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <memory>
 #include <numbers>
 #include <random>
@@ -18,6 +19,7 @@
 
 #include "scallop/bezier.hpp"
 #include "scallop/cut_simulation.hpp"
+#include "scallop/error.hpp"
 #include "scallop/face_trim.hpp"
 #include "scallop/gouge.hpp"
 #include "scallop/section.hpp"
@@ -246,6 +248,27 @@ TEST(TrimmedSurface, TheDesignIsTheFaceAlone) {
     EXPECT_GT(inside, 1000) << hole;
     EXPECT_GT(outside, 1000) << hole;
   }
+}
+
+// What a trimmed surface must be, and what it cannot be written as.
+TEST(TrimmedSurface, TrimsAreCheckedAndHaveNoJsonForm) {
+  TrimmedPaper trimmed(false);
+  EXPECT_NO_THROW(scallop::validateSurface(trimmed.surface));
+  const auto message = [](const std::function<void()>& call) {
+    try {
+      call();
+    } catch (const scallop::Error& error) {
+      return std::string(error.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(message([&] { (void)scallop::surfaceToJson(trimmed.surface); }).find("no JSON form"), std::string::npos);
+  Surface two = trimmed.surface;
+  two.patches.push_back(two.patches[0]);  // two patches, one trim
+  EXPECT_NE(message([&] { scallop::validateSurface(two); }).find("trims: 1 for 2 patches"), std::string::npos);
+  Surface flat = trimmed.surface;
+  flat.trims[0].v1 = flat.trims[0].v0;  // maps the square onto a segment
+  EXPECT_NE(message([&] { scallop::validateSurface(flat); }).find("not a rectangle"), std::string::npos);
 }
 
 }  // namespace

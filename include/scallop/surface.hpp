@@ -153,7 +153,7 @@ Surface readSurface(const std::string& path, SurfaceCheck check = SurfaceCheck::
 /// written shortest-round-trip (-0 as -0.0), so parseSurface(surfaceToJson(s)) reproduces
 /// every coordinate bit for bit. Deterministic. Writes any surface whose patches have
 /// degrees >= 0 and the matching number of finite control points (regularity is not
-/// checked); throws scallop::Error otherwise.
+/// checked) and no trims (they have no JSON form); throws scallop::Error otherwise.
 std::string surfaceToJson(const Surface& surface);
 
 /// Throws scallop::Error ("patches[i]...: ...") unless `surface` satisfies the contract.
