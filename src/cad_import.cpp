@@ -456,6 +456,10 @@ FaceTrim trimArcs(const TopoDS_Face& face) {
     Geom2dConvert_BSplineCurveToBezierCurve splitter(spline);
     for (int a = 1; a <= splitter.NbArcs(); ++a) {
       const Handle(Geom2d_BezierCurve) bezier = splitter.Arc(a);
+      if (static_cast<std::size_t>(bezier->NbPoles()) > kMaxTrimPoles)
+        throw FaceRefused{CadFaceIssue::unsupportedSurface,
+                          fmt::format("has a trimming curve (edge {}) of degree {}, above the {} supported", index,
+                                      bezier->Degree(), kMaxTrimPoles - 1)};
       TrimArc arc;
       for (int i = 1; i <= bezier->NbPoles(); ++i) {
         const gp_Pnt2d p = bezier->Pole(i);
