@@ -934,6 +934,17 @@ TEST_F(CadTessellationCli, TessellationOptionsAreRefusedWhereTheyDoNotApply) {
   fs::copy_file(kExamples + "/surfaces/paper-1.json", workDir_ / "paper-1.json");
   expectCleanFailure(run("plan paper-1.json --tessellate --out out"), {"--tessellate", "STEP and IGES"},
                      "paper-1.json");
+  // --exact-trims: for STEP and IGES parts, and not with the tessellation or --skip-faces.
+  expectCleanFailure(run("plan paper-1.json --exact-trims --out out"), {"paper-1.json", "--exact-trims", "STEP and IGES"},
+                     "paper-1.json");
+  expectCleanFailure(run("paths --example paper-1 --tool-radius 0.25 --scallop-height 0.002 --exact-trims --json o.json"),
+                     {"--exact-trims", "STEP and IGES"}, "paper-1.json");
+  fs::remove(workDir_ / "paper-1.json");
+  writeStep(pocketBlock(), workDir_ / "pocket.step", "MM");
+  expectCleanFailure(run("plan pocket.step --exact-trims --tessellate --out out"), {"pocket.step", "--tessellate"},
+                     "pocket.step");
+  expectCleanFailure(run("plan pocket.step --exact-trims --skip-faces --out out"), {"pocket.step", "--skip-faces"},
+                     "pocket.step");
 }
 
 }  // namespace
