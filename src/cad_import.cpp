@@ -754,8 +754,9 @@ FacePatches facePatches(const TopoDS_Face& face, Units units, Stage& stage, cons
                             fmt::format("is {} (piece {}), whose patches' parameters are not an affine image of the "
                                         "face's: its trim is followed by pieces only (not kept exactly)",
                                         surfaceKind(basis), index)};
-        // A patch wholly inside its face needs no trim.
-        const bool inside = pieceSplit.pieces.size() == 1 && pieceSplit.insidePieces == 1;
+        // A patch wholly inside its face needs no trim (its square classified inside: one
+        // inside piece alone may be a quarter whose siblings lie outside).
+        const bool inside = classifyBox(trim, parameters.box(ParameterCell{})) == CellPlace::inside;
         whole.push_back(patches[index]);
         result.trims.push_back(inside ? PatchTrim{} : *patchTrim);
       }
@@ -834,13 +835,7 @@ CadImport convertFaces(const CadFile& transferred, const std::string& path, cons
         result.surface.patches.push_back(std::move(patches.patches[p]));
         result.patchFaces.push_back(index);
         result.patchRoles.push_back(patches.roles[p]);
-        if (!patches.trims.empty()) {
-          // The first trimmed patch: every earlier patch is untrimmed.
-          result.surface.trims.resize(result.surface.patches.size() - 1);
-          result.surface.trims.push_back(patches.trims[p]);
-        } else if (result.surface.trimmed()) {
-          result.surface.trims.emplace_back();
-        }
+        result.surface.trims.push_back(patches.trims.empty() ? PatchTrim{} : patches.trims[p]);
       }
       if (patches.trimmed) {
         ++result.trimmedFaces;
@@ -858,6 +853,10 @@ CadImport convertFaces(const CadFile& transferred, const std::string& path, cons
     }
   }
   result.faces = index;
+  // No patch trimmed: no trims (surface.hpp: empty, or one per patch).
+  if (std::none_of(result.surface.trims.begin(), result.surface.trims.end(),
+                   [](const PatchTrim& trim) { return trim.trimmed(); }))
+    result.surface.trims.clear();
   if (index == 0)
     throw Error(fmt::format("{}: no faces in the file ({} root entities transferred): nothing to machine", path,
                             transferred.roots));

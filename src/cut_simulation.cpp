@@ -549,9 +549,8 @@ void designHeights(const Surface& surface, HeightGrid& grid, std::vector<double>
   if (normalZ) normalZ->assign(grid.z.size(), 0.0);
   const double tolerance = 1e-12 * std::max(surfaceScale(surface), 1e-300);
   for (std::size_t i = 0; i < surface.patches.size(); ++i) {
-    const PatchTrim* trim = surface.trimmed() && surface.trims[i].trimmed() ? &surface.trims[i] : nullptr;
-    designCell(DesignPatch{surface.patches[i], jacobianSign(surface.patches[i]), tolerance, trim}, 0.0, 1.0, 0.0, 1.0,
-               0, grid, normalZ);
+    designCell(DesignPatch{surface.patches[i], jacobianSign(surface.patches[i]), tolerance, patchTrim(surface, i)}, 0.0,
+               1.0, 0.0, 1.0, 0, grid, normalZ);
   }
 }
 

@@ -600,6 +600,13 @@ struct ByLowerBound {
 constexpr std::size_t kStoreEntries = 1024;
 constexpr std::size_t kStoreSlots = 4 * kStoreEntries;  // a power of 2; at most 1/4 full
 
+// A cell's key (position iu, iv at its depth, in its patch) mixed into 64 bits.
+std::uint64_t mixCellKey(std::uint64_t iu, std::uint64_t iv, std::uint32_t patch, int depth) {
+  std::uint64_t k = iu * 0x9E3779B97F4A7C15ULL ^ (iv + 0x632BE59BD9B4E019ULL) * 0xC2B2AE3D27D4EB4FULL;
+  k ^= (static_cast<std::uint64_t>(patch) << 8 | static_cast<std::uint64_t>(depth)) * 0x165667B19E3779F9ULL;
+  return k ^ (k >> 29);
+}
+
 struct CellStore {
   struct Slot {
     std::uint64_t iu = 0;
@@ -628,9 +635,7 @@ struct CellStore {
   }
 
   static std::size_t hash(std::uint64_t iu, std::uint64_t iv, std::uint32_t patch, int depth) {
-    std::uint64_t k = iu * 0x9E3779B97F4A7C15ULL ^ (iv + 0x632BE59BD9B4E019ULL) * 0xC2B2AE3D27D4EB4FULL;
-    k ^= (static_cast<std::uint64_t>(patch) << 8 | static_cast<std::uint64_t>(depth)) * 0x165667B19E3779F9ULL;
-    return static_cast<std::size_t>(k ^ (k >> 29)) & (kStoreSlots - 1);
+    return static_cast<std::size_t>(mixCellKey(iu, iv, patch, depth)) & (kStoreSlots - 1);
   }
 
   // The quarters of the cell (patch, depth, iu, iv) with the net `parent` (m, n its
@@ -979,7 +984,6 @@ PatchTree buildTree(const BezierPatch& patch, int depth) {
   return tree;
 }
 
-// The branch and bound of the contract.
 // Cells of trimmed patches classified, kept per thread across queries (keyed by the
 // SurfaceDistance's id, patch, depth and position): consecutive queries classify the same
 // cells, and classifying one halves the face's arcs down to its size. Emptied past 2^20.
@@ -992,10 +996,7 @@ struct TrimCellKey {
 
 struct TrimCellHash {
   std::size_t operator()(const TrimCellKey& k) const {
-    std::uint64_t h = k.iu * 0x9E3779B97F4A7C15ULL ^ (k.iv + 0x632BE59BD9B4E019ULL) * 0xC2B2AE3D27D4EB4FULL;
-    h ^= (k.id << 40 ^ static_cast<std::uint64_t>(k.patch) << 8 ^ static_cast<std::uint64_t>(k.depth)) *
-         0x165667B19E3779F9ULL;
-    return static_cast<std::size_t>(h ^ (h >> 29));
+    return static_cast<std::size_t>(mixCellKey(k.iu, k.iv, k.patch, k.depth) ^ (k.id * 0xD6E8FEB86659FD93ULL));
   }
 };
 
@@ -1030,9 +1031,10 @@ bool inFace(const std::vector<PatchTrim>* trims, std::size_t patch, double u, do
   return trims == nullptr || keepsPoint((*trims)[patch], u, v);
 }
 
-ClosestPoint search(const Surface& surface, const std::vector<PatchTree>& trees, const std::vector<PatchNode>& nodes,
-                    const std::vector<std::uint32_t>& nodePatches, std::uint64_t id, double tolerance,
-                    std::size_t maxCells, Vec3 p, double cutoff) {
+// The branch and bound of the contract (`scale`: the surface's, surfaceScale).
+ClosestPoint search(const Surface& surface, double scale, const std::vector<PatchTree>& trees,
+                    const std::vector<PatchNode>& nodes, const std::vector<std::uint32_t>& nodePatches,
+                    std::uint64_t id, double tolerance, std::size_t maxCells, Vec3 p, double cutoff) {
   if (!isFinite(p)) {
     throw Error(
         fmt::format("surface distance: the query point ({}, {}, {}) is not finite", p.x, p.y, p.z));
@@ -1056,9 +1058,6 @@ ClosestPoint search(const Surface& surface, const std::vector<PatchTree>& trees,
   const auto consider = [&](Vec3 q, std::size_t patch, double u, double v, bool known) {
     const double d = norm(q - p);
     if (d < best.distance && known) best = {d, patch, u, v, q};
-  };
-  const auto considerTested = [&](Vec3 q, std::size_t patch, double u, double v) {
-    consider(q, patch, u, v, inFace(trims, patch, u, v));
   };
   // Bounds a new cell: its corners are surface points (upper bounds); then its lower bound,
   // the axis-aligned box first (cheap, precomputed in the tree) and the separating plane
@@ -1108,12 +1107,9 @@ ClosestPoint search(const Surface& surface, const std::vector<PatchTree>& trees,
     const Jet jet = jetAt(patch, uc, vc);
     if (norm(jet.r - p) < best.distance) {
       const Candidate polished = newton(patch, cell.patch, p, uc, vc, jet);
-      if (cell.inFace) {
-        consider(jet.r, cell.patch, uc, vc, true);
-      } else {
-        considerTested(jet.r, cell.patch, uc, vc);
-      }
-      considerTested(polished.point, cell.patch, polished.u, polished.v);  // Newton may leave the cell
+      consider(jet.r, cell.patch, uc, vc, cell.inFace || inFace(trims, cell.patch, uc, vc));
+      // Newton may leave the cell: its point is always tested.
+      consider(polished.point, cell.patch, polished.u, polished.v, inFace(trims, cell.patch, polished.u, polished.v));
     }
     if (cell.lower >= level()) {
       setAside = std::min(setAside, cell.lower);
@@ -1131,8 +1127,9 @@ ClosestPoint search(const Surface& surface, const std::vector<PatchTree>& trees,
       setAside = std::min(setAside, cell.lower);
       continue;
     }
-    if (cell.depth >= kTrimCellDepth && trims != nullptr && !cell.inFace && (*trims)[cell.patch].trimmed()) {
-      // On a trimming curve and as fine as the trim is followed: its bound stands.
+    if (cell.depth >= kTrimCellDepth && !cell.inFace) {
+      // On a trimming curve (cells of untrimmed patches are all inFace) and as fine as the
+      // trim is followed: its bound stands.
       setAside = std::min(setAside, cell.lower);
       trimResolved = true;
       continue;
@@ -1152,7 +1149,7 @@ ClosestPoint search(const Surface& surface, const std::vector<PatchTree>& trees,
   result.point = best.point;
   result.lowerBound = std::max(0.0, std::min({lowerBound, walk.waiting(), setAside, best.distance}));
   // Beside a trimming curve the bound is as fine as the cells there (see the contract).
-  const double reach = trimResolved ? tolerance + kTrimCellReach * (surfaceScale(surface) + pScale) : tolerance;
+  const double reach = trimResolved ? tolerance + kTrimCellReach * (scale + pScale) : tolerance;
   result.converged = best.distance - result.lowerBound <= reach || result.lowerBound >= cutoff;
   result.cells = cells;
   return result;
@@ -1224,8 +1221,8 @@ SegmentClearance segmentSearch(const std::vector<PatchTree>& trees, const std::v
   SegmentClearance result;
   const QuerySegment segment(a, b);
   const double pScale = std::max(maxAbs(a), maxAbs(b));
-  // A surface point nearer than the clearance refutes it; the nearest seen is kept.
   bool trimUnresolved = false;  // a cell on a trimming curve left at kTrimCellDepth within the clearance
+  // A surface point nearer than the clearance refutes it; the nearest seen is kept.
   bool violated = false;
   // Corners of cells on a trimming curve are not tested (`known` false): the inside cells
   // beside them, as fine, offer theirs.
@@ -1281,7 +1278,7 @@ SegmentClearance segmentSearch(const std::vector<PatchTree>& trees, const std::v
       result.verdict = Clearance::undecided;
       return result;
     }
-    if (cell.depth >= kTrimCellDepth && trims != nullptr && !cell.inFace && (*trims)[cell.patch].trimmed()) {
+    if (cell.depth >= kTrimCellDepth && !cell.inFace) {  // on a trimming curve (see search)
       trimUnresolved = true;  // on a trimming curve, as fine as the trim is followed: not proven
       continue;
     }
@@ -1451,7 +1448,8 @@ SurfaceDistance::SurfaceDistance(const Surface& surface, const DistanceOptions& 
   // Ids from 1 (0 marks an empty cell store); copies share theirs with the cells they hold.
   static std::atomic<std::uint64_t> lastId{0};
   id_ = lastId.fetch_add(1, std::memory_order_relaxed) + 1;
-  tolerance_ = options.tolerance > 0.0 ? options.tolerance : 1e-9 * surfaceScale(surface_);
+  scale_ = surfaceScale(surface_);
+  tolerance_ = options.tolerance > 0.0 ? options.tolerance : 1e-9 * scale_;
   // A surface collapsed to the origin has scale 0; any positive tolerance will do there.
   if (!(tolerance_ > 0.0)) tolerance_ = std::numeric_limits<double>::min();
   // The trees' depth, lowered for all patches alike to keep within kTreePointsBudget: deeper
@@ -1480,7 +1478,7 @@ SurfaceDistance& SurfaceDistance::operator=(SurfaceDistance&&) noexcept = defaul
 ClosestPoint SurfaceDistance::closest(Vec3 p) const { return closest(p, kInfinity); }
 
 ClosestPoint SurfaceDistance::closest(Vec3 p, double cutoff) const {
-  return search(surface_, trees_, nodes_, nodePatches_, id_, tolerance_, options_.maxCells, p, cutoff);
+  return search(surface_, scale_, trees_, nodes_, nodePatches_, id_, tolerance_, options_.maxCells, p, cutoff);
 }
 
 SegmentClearance SurfaceDistance::segmentClearance(Vec3 a, Vec3 b, double clearance,

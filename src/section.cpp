@@ -478,19 +478,20 @@ PlaneSection planeSection(const Surface& surface, const Vec3& normal, double off
   std::vector<Piece> pieces;
   for (std::size_t i = 0; i < surface.patches.size(); ++i) {
     PatchSection section(surface.patches[i], i, n, d);
-    if (!surface.trimmed() || !surface.trims[i].trimmed()) {
+    const PatchTrim* trim = patchTrim(surface, i);
+    if (trim == nullptr) {
       sectionPatch(section, chordalTolerance, pieces, out.touchPoints, out.cells);
       continue;
     }
     // A trimmed patch: its pieces clipped at the trimming curves, its touch points kept
     // only inside its face.
-    if (classifyCell(surface.trims[i], ParameterCell{}) == CellPlace::outside) continue;
+    if (classifyCell(*trim, ParameterCell{}) == CellPlace::outside) continue;
     std::vector<Piece> own;
     std::vector<SectionPoint> touches;
     sectionPatch(section, chordalTolerance, own, touches, out.cells);
-    for (const Piece& piece : own) clipPiece(piece, surface.patches[i], surface.trims[i], n, d, pieces);
+    for (const Piece& piece : own) clipPiece(piece, surface.patches[i], *trim, n, d, pieces);
     for (const SectionPoint& touch : touches)
-      if (keepsPoint(surface.trims[i], touch.u, touch.v)) out.touchPoints.push_back(touch);
+      if (keepsPoint(*trim, touch.u, touch.v)) out.touchPoints.push_back(touch);
   }
   const double scale = std::max(surfaceScale(surface), 1e-300);
   joinPieces(std::move(pieces), kJoinTolerance * scale, out);

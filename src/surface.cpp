@@ -905,15 +905,15 @@ void validateSurface(const Surface& surface) {
     throw Error(fmt::format("trims: {} for {} patches; one per patch or none", surface.trims.size(),
                             surface.patches.size()));
   for (std::size_t i = 0; i < surface.patches.size(); ++i) {
-    const bool trimmed = surface.trimmed() && surface.trims[i].trimmed();
+    const PatchTrim* const trimmed = patchTrim(surface, i);
     if (trimmed) {
-      const PatchTrim& trim = surface.trims[i];
+      const PatchTrim& trim = *trimmed;
       if (!std::isfinite(trim.u0) || !std::isfinite(trim.u1) || !std::isfinite(trim.v0) || !std::isfinite(trim.v1) ||
           trim.u0 == trim.u1 || trim.v0 == trim.v1 || !(trim.margin >= 0.0) || !std::isfinite(trim.margin))
         throw Error(fmt::format("{}: its trim maps [0, 1]^2 onto [{}, {}] x [{}, {}] (margin {}): not a rectangle",
                                 patchPath(i), trim.u0, trim.u1, trim.v0, trim.v1, trim.margin));
     }
-    validatePatch(surface.patches[i], i, !trimmed);
+    validatePatch(surface.patches[i], i, trimmed == nullptr);
   }
 }
 

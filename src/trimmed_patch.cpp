@@ -118,13 +118,13 @@ Surface trimmedPieces(const Surface& surface, const TrimSplitOptions& options) {
   Surface pieces;
   pieces.units = surface.units;
   for (std::size_t i = 0; i < surface.patches.size(); ++i) {
-    if (!surface.trimmed() || !surface.trims[i].trimmed()) {
+    const PatchTrim* trim = patchTrim(surface, i);
+    if (trim == nullptr) {
       pieces.patches.push_back(surface.patches[i]);
       continue;
     }
-    const PatchTrim& trim = surface.trims[i];
     TrimSplit split = splitTrimmedPatch(
-        surface.patches[i], [&](const ParameterCell& cell) { return classifyCell(trim, cell); }, options);
+        surface.patches[i], [&](const ParameterCell& cell) { return classifyCell(*trim, cell); }, options);
     for (TrimmedPiece& piece : split.pieces) pieces.patches.push_back(std::move(piece.patch));
   }
   return pieces;

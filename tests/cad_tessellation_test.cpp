@@ -109,8 +109,12 @@ double pocketBlockHeight(double x, double y, double band) {
 // Paper-1's patch (inches, written in mm) trimmed to the disk of radius 0.3 around the middle
 // of its parameter square: x = 3 v, y = 3 u on that patch, so the face is the part of the
 // surface over the disk of radius 0.9 in around (1.5, 1.5) in.
-TopoDS_Shape paperDiskFace(const Surface& paper) {
+TopoDS_Shape paperDiskFace(const Surface& paper, const std::vector<double>& knots = {}) {
   const Handle(Geom_BSplineSurface) surface = scallop::test::bsplineOf(paper.patches[0], 25.4);
+  for (const double knot : knots) {  // split into more Bezier patches (full multiplicity)
+    surface->InsertUKnot(knot, 3, 1e-12);
+    surface->InsertVKnot(knot, 3, 1e-12);
+  }
   const Handle(Geom2d_Circle) circle = new Geom2d_Circle(gp_Ax2d(gp_Pnt2d(0.5, 0.5), gp_Dir2d(1, 0)), 0.3);
   TopoDS_Edge edge = BRepBuilderAPI_MakeEdge(circle, surface).Edge();
   BRepLib::BuildCurves3d(edge);
@@ -364,6 +368,34 @@ double patchArea(const scallop::BezierPatch& patch) {
 // between the inside pieces' and all pieces', and the slicing of the pieces brackets alpha*
 // against the normals sampled densely over the disk (scallop's derivatives at points chosen
 // here, not OCCT's classification).
+// keepTrims: the disk-trimmed face split at 0.4 and 0.6 in u and v (9 Bezier patches; the
+// disk of radius 0.3 about (0.5, 0.5) holds the middle one, misses none). The middle patch is
+// kept without a trim, and every patch kept without one lies in the disk (its points' (u, v)
+// in closed form); the others keep the face's trim and the map to its parameters.
+TEST_F(CadTessellationTest, KeptTrimsLeaveOnlyPatchesWhollyInsideTheFaceUntrimmed) {
+  const Surface paper = exampleFile("paper-1");
+  const fs::path path = dir_ / "split-disk.step";
+  writeStep(paperDiskFace(paper, {0.4, 0.6}), path, "INCH");
+  scallop::CadImportOptions options;
+  options.acceptTrimmed = options.keepTrims = true;
+  const scallop::CadImport imported = scallop::importCad(path.string(), options);
+  ASSERT_EQ(imported.surface.patches.size(), 9u);
+  ASSERT_TRUE(imported.surface.trimmed());
+  std::size_t untrimmed = 0;
+  for (std::size_t i = 0; i < 9; ++i) {
+    const scallop::BezierPatch& patch = imported.surface.patches[i];
+    if (imported.surface.trims[i].trimmed()) continue;
+    ++untrimmed;
+    for (int a = 0; a <= 4; ++a)
+      for (int b = 0; b <= 4; ++b) {
+        // x = 3 v, y = 3 u on paper-1's patch: the face's (u, v) from the point.
+        const Vec3 q = scallop::point(patch, a / 4.0, b / 4.0);
+        EXPECT_LE(std::hypot(q.y / 3.0 - 0.5, q.x / 3.0 - 0.5), 0.3 + 1e-9) << "patch " << i;
+      }
+  }
+  EXPECT_EQ(untrimmed, 1u);
+}
+
 TEST_F(CadTessellationTest, ATrimmedFaceBecomesPiecesThatFollowItsTrimmingCurve) {
   const Surface paper = exampleFile("paper-1");
   const fs::path path = dir_ / "disk.step";

@@ -268,6 +268,7 @@ class SurfaceDistance {
   Surface surface_;
   DistanceOptions options_;
   double tolerance_ = 0.0;
+  double scale_ = 0.0;  // surfaceScale(surface_)
   std::vector<detail::PatchTree> trees_;  // one per patch
   std::vector<detail::PatchNode> nodes_;  // the patches' boxes in a hierarchy; nodes_[0] the root
   std::vector<std::uint32_t> nodePatches_;  // the patches of the leaves, leaf by leaf

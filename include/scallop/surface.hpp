@@ -232,11 +232,17 @@ std::vector<PatchPiece> cornerPieces(const BezierPatch& patch, std::size_t sourc
 /// slicing's polish and certificate) works on these pieces.
 Surface cornerResolved(const Surface& surface, std::vector<std::size_t>* sources = nullptr);
 
+/// The trim of patch `patch`, or nullptr when it is not trimmed.
+inline const PatchTrim* patchTrim(const Surface& surface, std::size_t patch) {
+  return surface.trimmed() && surface.trims[patch].trimmed() ? &surface.trims[patch] : nullptr;
+}
+
 /// Whether the point (u, v) of patch `patch` belongs to the surface: always for an untrimmed
 /// patch, inside its face or on a trimming curve for a trimmed one (face_trim.hpp's
 /// keepsPoint). Samplers of patches skip the points it refuses.
 inline bool surfaceKeepsPoint(const Surface& surface, std::size_t patch, double u, double v) {
-  return !surface.trimmed() || keepsPoint(surface.trims[patch], u, v);
+  const PatchTrim* trim = patchTrim(surface, patch);
+  return trim == nullptr || keepsPoint(*trim, u, v);
 }
 
 /// A trimmed surface's patches as pieces that follow their faces (trimmed_patch.hpp's
