@@ -168,16 +168,18 @@ CadRoute cadRoute(const SurfaceSource& source, bool tessellate, const std::strin
 
 void addExactTrimsOption(CLI::App& command, SurfaceSource& source) {
   command.add_flag("--exact-trims", source.exactTrims,
-                   "STEP/IGES: take trimmed faces of B-spline and Bezier surfaces (and planes) exactly, with their "
-                   "trimming curves, instead of cutting the part through its tessellation (a part with another trimmed "
-                   "face is still tessellated)");
+                   "STEP/IGES: take trimmed faces exactly, with their trimming curves (B-spline and Bezier surfaces, "
+                   "planes, and the cylinders, cones, spheres, tori and revolutions OCCT converts with rational "
+                   "quadratic circles), instead of cutting the part through its tessellation (a part with another "
+                   "trimmed face is still tessellated)");
 }
 
 CadImportOptions exactRationalFaces(const SurfaceSource& source) {
   CadImportOptions options;
   options.acceptRational = true;
-  // Trimmed faces of B-spline and Bezier surfaces (and planes) exactly, with their trims;
-  // others (cylinders, cones, ... trimmed) leave the part to the tessellation.
+  // Trimmed faces exactly, with their trims, where each patch parameter maps onto the face's
+  // affinely or by half-angles (cad_import.hpp's keepTrims); others leave the part to the
+  // tessellation.
   options.acceptTrimmed = source.exactTrims;
   options.keepTrims = source.exactTrims;
   return options;

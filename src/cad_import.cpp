@@ -531,19 +531,19 @@ class PieceParameters {
     }
   }
 
-  // The patch's trim (face_trim.hpp's PatchTrim) when its parameters map affinely onto the
-  // face's: checked at the middle and quarter points (1e-12 of the span; the identity, up to
-  // the period, for B-spline and Bezier faces; planes too); nullopt otherwise.
-  std::optional<PatchTrim> affineTrim(std::shared_ptr<const FaceTrim> face) {
+  // The patch's trim (face_trim.hpp's PatchTrim) when each of its parameters maps onto the
+  // face's affinely (B-spline and Bezier faces: the identity up to the period; planes; the
+  // heights of cylinders and cones) or, on a converted face, by half-angles (the angles of
+  // OCCT's rational quadratic circles): fitted through the ends and the middle, and checked
+  // at six more points against OCCT's parameters of the patch's points (kAxisMapFit of the
+  // span); nullopt when neither fits.
+  std::optional<PatchTrim> patchTrim(std::shared_ptr<const FaceTrim> face) {
     const auto atS = [&](double s) { return faceU(knotU0_ + (reversed_ ? 1.0 - s : s) * (knotU1_ - knotU0_)); };
     const auto atT = [&](double t) { return faceV(knotV0_ + t * (knotV1_ - knotV0_)); };
+    std::optional<AxisMap> u = axisMap(atS), v = axisMap(atT);
+    if (!u || !v) return std::nullopt;
     PatchTrim trim;
-    trim.u0 = atS(0.0), trim.u1 = atS(1.0), trim.v0 = atT(0.0), trim.v1 = atT(1.0);
-    for (const double f : {0.25, 0.5, 0.75}) {
-      if (!(std::abs(atS(f) - (trim.u0 + f * (trim.u1 - trim.u0))) <= 1e-12 * std::abs(trim.u1 - trim.u0)) ||
-          !(std::abs(atT(f) - (trim.v0 + f * (trim.v1 - trim.v0))) <= 1e-12 * std::abs(trim.v1 - trim.v0)))
-        return std::nullopt;
-    }
+    trim.u = *u, trim.v = *v;
     trim.face = std::move(face);
     trim.margin = std::max(marginU_, marginV_);
     return trim;
@@ -559,6 +559,29 @@ class PieceParameters {
   }
 
  private:
+  // How closely a fitted map must follow OCCT's parameters, relative to its span: rounding
+  // (the angles come from atan2 of points converted through the B-spline's poles).
+  static constexpr double kAxisMapFit = 1e-11;
+
+  template <typename At>
+  std::optional<AxisMap> axisMap(At at) const {
+    const double from = at(0.0), middle = at(0.5), to = at(1.0);
+    const auto fits = [&](const AxisMap& map) {
+      for (const double x : {0.125, 0.25, 0.375, 0.5, 0.625, 0.75, 0.875})
+        if (!(std::abs(map.at(x) - at(x)) <= kAxisMapFit * std::abs(to - from))) return false;
+      return true;
+    };
+    const AxisMap affine = AxisMap::affine(from, to);
+    if (fits(affine)) return affine;
+    if (!converted_) return std::nullopt;
+    try {
+      const AxisMap angles = AxisMap::halfAngle(from, middle, to);
+      if (fits(angles)) return angles;
+    } catch (const Error&) {  // not a monotone arc
+    }
+    return std::nullopt;
+  }
+
   static double nearest(double x, double reference, double period) {
     return period > 0.0 ? x - period * std::round((x - reference) / period) : x;
   }
@@ -748,11 +771,12 @@ FacePatches facePatches(const TopoDS_Face& face, Units units, Stage& stage, cons
       trimBudget -= std::min(trimBudget, weight * pieceSplit.pieces.size());
       result.largestSpreadRad = std::max(result.largestSpreadRad, pieceSplit.largestSpreadRad);
       if (options.keepTrims && !pieceSplit.pieces.empty()) {
-        std::optional<PatchTrim> patchTrim = parameters.affineTrim(shared);
+        std::optional<PatchTrim> patchTrim = parameters.patchTrim(shared);
         if (!patchTrim)
           throw FaceRefused{CadFaceIssue::trimmed,
-                            fmt::format("is {} (piece {}), whose patches' parameters are not an affine image of the "
-                                        "face's: its trim is followed by pieces only (not kept exactly)",
+                            fmt::format("is {} (piece {}), whose patches' parameters are neither an affine nor a "
+                                        "half-angle image of the face's: its trim is followed by pieces only (not "
+                                        "kept exactly)",
                                         surfaceKind(basis), index)};
         // A patch wholly inside its face needs no trim (its square classified inside: one
         // inside piece alone may be a quarter whose siblings lie outside).

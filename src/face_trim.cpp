@@ -183,10 +183,54 @@ bool mayMeet(const TrimArc& arc, const ParameterBox& box) {
   return false;
 }
 
+AxisMap AxisMap::affine(double from, double to) {
+  AxisMap map;
+  map.from = from, map.to = to;
+  return map;
+}
+
+AxisMap AxisMap::halfAngle(double from, double middle, double to) {
+  // tan((angle - middle) / 2) at the ends: -1/2 / offset at 0, 1/2 / (slope + offset) at 1.
+  const double atStart = std::tan(0.5 * (from - middle)), atEnd = std::tan(0.5 * (to - middle));
+  if (!(std::abs(from - middle) < std::numbers::pi) || !(std::abs(to - middle) < std::numbers::pi) ||
+      !(atStart * atEnd < 0.0))
+    throw Error(fmt::format("the angles {}, {}, {} (radians) at the start, middle and end of a patch are not a "
+                            "monotone arc of less than a turn",
+                            from, middle, to));
+  AxisMap map;
+  map.kind = Kind::halfAngle;
+  map.from = from, map.to = to, map.middle = middle;
+  map.offset = -0.5 / atStart;
+  map.slope = 0.5 / atEnd - map.offset;
+  return map;
+}
+
+double AxisMap::at(double x) const {
+  if (kind == Kind::affine) return from + x * (to - from);
+  return middle + 2.0 * std::atan((x - 0.5) / (slope * x + offset));
+}
+
+void validateAxisMap(const AxisMap& map, const char* what) {
+  bool valid = std::isfinite(map.from) && std::isfinite(map.to) && map.from != map.to;
+  if (valid && map.kind == AxisMap::Kind::halfAngle) {
+    // The denominator slope x + offset keeps its sign on [0, 1] (it is linear): then the map
+    // is continuous and its derivative, (offset + slope / 2) / denominator^2, keeps one sign.
+    valid = std::isfinite(map.middle) && std::isfinite(map.slope) && std::isfinite(map.offset) &&
+            map.offset * (map.slope + map.offset) > 0.0 && map.offset + 0.5 * map.slope != 0.0;
+  }
+  if (!valid)
+    throw Error(fmt::format("{}: maps [0, 1] onto [{}, {}]{}: not a monotone map onto an interval", what, map.from,
+                            map.to,
+                            map.kind == AxisMap::Kind::halfAngle
+                                ? fmt::format(" by half-angles (middle {}, slope {}, offset {})", map.middle,
+                                              map.slope, map.offset)
+                                : std::string()));
+}
+
 CellPlace classifyCell(const PatchTrim& trim, const ParameterCell& cell) {
   if (!trim.trimmed()) return CellPlace::inside;
-  const double ua = trim.u0 + cell.u0 * (trim.u1 - trim.u0), ub = trim.u0 + cell.u1 * (trim.u1 - trim.u0);
-  const double va = trim.v0 + cell.v0 * (trim.v1 - trim.v0), vb = trim.v0 + cell.v1 * (trim.v1 - trim.v0);
+  const double ua = trim.u.at(cell.u0), ub = trim.u.at(cell.u1);
+  const double va = trim.v.at(cell.v0), vb = trim.v.at(cell.v1);
   const ParameterBox box{std::min(ua, ub) - trim.margin, std::max(ua, ub) + trim.margin,
                          std::min(va, vb) - trim.margin, std::max(va, vb) + trim.margin};
   return classifyBox(*trim.face, box);
@@ -194,8 +238,7 @@ CellPlace classifyCell(const PatchTrim& trim, const ParameterCell& cell) {
 
 bool keepsPoint(const PatchTrim& trim, double s, double t) {
   if (!trim.trimmed()) return true;
-  return classifyPoint(*trim.face, trim.u0 + s * (trim.u1 - trim.u0), trim.v0 + t * (trim.v1 - trim.v0)) !=
-         CellPlace::outside;
+  return classifyPoint(*trim.face, trim.u.at(s), trim.v.at(t)) != CellPlace::outside;
 }
 
 }  // namespace scallop

@@ -987,17 +987,17 @@ PatchTree buildTree(const BezierPatch& patch, int depth) {
 // Cells of trimmed patches classified, kept per thread across queries (keyed by the
 // SurfaceDistance's id, patch, depth and position): consecutive queries classify the same
 // cells, and classifying one halves the face's arcs down to its size. Emptied past 2^20.
-struct TrimCellKey {
-  std::uint64_t id = 0, iu = 0, iv = 0;
-  std::uint32_t patch = 0;
-  int depth = 0;
-  bool operator==(const TrimCellKey&) const = default;
-};
-
-struct TrimCellHash {
-  std::size_t operator()(const TrimCellKey& k) const {
-    return static_cast<std::size_t>(mixCellKey(k.iu, k.iv, k.patch, k.depth) ^ (k.id * 0xD6E8FEB86659FD93ULL));
-  }
+// The per-thread cache of trimmed cells' places: a direct-mapped table (a slot per hash,
+// overwritten on collision: a lost entry is classified again), no allocation per cell.
+struct TrimCellCache {
+  static constexpr std::size_t kSlots = std::size_t{1} << 18;
+  struct Slot {
+    std::uint64_t id = 0, iu = 0, iv = 0;  // id 0: empty (SurfaceDistance ids start at 1)
+    std::uint32_t patch = 0;
+    int depth = 0;
+    CellPlace place = CellPlace::boundary;
+  };
+  std::vector<Slot> slots = std::vector<Slot>(kSlots);
 };
 
 // A trimmed patch's cell (trims non-null and the patch trimmed, the cell not known inside):
@@ -1008,21 +1008,19 @@ bool classifyForTrim(const std::vector<PatchTrim>* trims, std::uint64_t id, Cell
     cell.inFace = true;  // all of an untrimmed patch is surface
     return true;
   }
-  thread_local std::unordered_map<TrimCellKey, CellPlace, TrimCellHash> known;
+  thread_local TrimCellCache cache;
   const double h = cellSide(cell.depth);
   const double cells = cellSide(-cell.depth);
-  const TrimCellKey key{id, static_cast<std::uint64_t>(cell.u0 * cells), static_cast<std::uint64_t>(cell.v0 * cells),
-                        cell.patch, cell.depth};
-  CellPlace place;
-  if (const auto found = known.find(key); found != known.end()) {
-    place = found->second;
-  } else {
-    place = classifyCell((*trims)[cell.patch], ParameterCell{cell.u0, cell.u0 + h, cell.v0, cell.v0 + h});
-    if (known.size() >= (std::size_t{1} << 20)) known.clear();
-    known.emplace(key, place);
+  const auto iu = static_cast<std::uint64_t>(cell.u0 * cells), iv = static_cast<std::uint64_t>(cell.v0 * cells);
+  TrimCellCache::Slot& slot =
+      cache.slots[static_cast<std::size_t>(mixCellKey(iu, iv, cell.patch, cell.depth) ^ (id * 0xD6E8FEB86659FD93ULL)) &
+                  (TrimCellCache::kSlots - 1)];
+  if (slot.id != id || slot.iu != iu || slot.iv != iv || slot.patch != cell.patch || slot.depth != cell.depth) {
+    slot = {id, iu, iv, cell.patch, cell.depth,
+            classifyCell((*trims)[cell.patch], ParameterCell{cell.u0, cell.u0 + h, cell.v0, cell.v0 + h})};
   }
-  if (place == CellPlace::outside) return false;
-  cell.inFace = place == CellPlace::inside;
+  if (slot.place == CellPlace::outside) return false;
+  cell.inFace = slot.place == CellPlace::inside;
   return true;
 }
 
@@ -1109,7 +1107,11 @@ ClosestPoint search(const Surface& surface, double scale, const std::vector<Patc
       const Candidate polished = newton(patch, cell.patch, p, uc, vc, jet);
       consider(jet.r, cell.patch, uc, vc, cell.inFace || inFace(trims, cell.patch, uc, vc));
       // Newton may leave the cell: its point is always tested.
-      consider(polished.point, cell.patch, polished.u, polished.v, inFace(trims, cell.patch, polished.u, polished.v));
+      // A point of a cell known inside the face is in it (no winding to count).
+      const bool inCell = polished.u >= cell.u0 && polished.u <= cell.u0 + h && polished.v >= cell.v0 &&
+                          polished.v <= cell.v0 + h;
+      consider(polished.point, cell.patch, polished.u, polished.v,
+               (cell.inFace && inCell) || inFace(trims, cell.patch, polished.u, polished.v));
     }
     if (cell.lower >= level()) {
       setAside = std::min(setAside, cell.lower);

@@ -908,10 +908,11 @@ void validateSurface(const Surface& surface) {
     const PatchTrim* const trimmed = patchTrim(surface, i);
     if (trimmed) {
       const PatchTrim& trim = *trimmed;
-      if (!std::isfinite(trim.u0) || !std::isfinite(trim.u1) || !std::isfinite(trim.v0) || !std::isfinite(trim.v1) ||
-          trim.u0 == trim.u1 || trim.v0 == trim.v1 || !(trim.margin >= 0.0) || !std::isfinite(trim.margin))
-        throw Error(fmt::format("{}: its trim maps [0, 1]^2 onto [{}, {}] x [{}, {}] (margin {}): not a rectangle",
-                                patchPath(i), trim.u0, trim.u1, trim.v0, trim.v1, trim.margin));
+      const std::string what = patchPath(i);
+      validateAxisMap(trim.u, (what + ": its trim's u").c_str());
+      validateAxisMap(trim.v, (what + ": its trim's v").c_str());
+      if (!(trim.margin >= 0.0) || !std::isfinite(trim.margin))
+        throw Error(fmt::format("{}: its trim's margin {} is not a finite non-negative number", what, trim.margin));
     }
     validatePatch(surface.patches[i], i, trimmed == nullptr);
   }

@@ -542,6 +542,29 @@ TEST(CadTrimmedSamples, ScrewStepsCertifiedDirectionClearsEveryNormalOcctSamples
 // seams). The winding parity of the arcs the importer keeps (face_trim.hpp's classifyPoint)
 // against OCCT's own BRepClass_FaceClassifier on a 41 x 41 grid over each face's UV bounds:
 // wherever both decide (the winding's "boundary" and OCCT's ON are left out), they agree.
+// A sample's faces, read by OCCT alone in the importer's order, IGES B-splines as written.
+std::vector<TopoDS_Face> occtFaces(const std::string& path) {
+  scallop::test::quietOcct();
+  TopoDS_Shape shape;
+  if (path.ends_with(".step")) {
+    STEPControl_Reader reader;
+    if (reader.ReadFile(path.c_str()) != IFSelect_RetDone) return {};
+    reader.TransferRoots();
+    shape = reader.OneShape();
+  } else {
+    const std::string saved = Interface_Static::CVal("read.iges.bspline.continuity");
+    Interface_Static::SetCVal("read.iges.bspline.continuity", "0");
+    IGESControl_Reader reader;
+    if (reader.ReadFile(path.c_str()) != IFSelect_RetDone) return {};
+    reader.TransferRoots();
+    shape = reader.OneShape();
+    Interface_Static::SetCVal("read.iges.bspline.continuity", saved.c_str());
+  }
+  std::vector<TopoDS_Face> faces;
+  for (TopExp_Explorer it(shape, TopAbs_FACE); it.More(); it.Next()) faces.push_back(TopoDS::Face(it.Current()));
+  return faces;
+}
+
 TEST(CadTrimmedSamples, TheArcsWindingAgreesWithOcctsClassifierOnEveryTrimmedFace) {
   struct Sample {
     std::string file;
@@ -561,25 +584,7 @@ TEST(CadTrimmedSamples, TheArcsWindingAgreesWithOcctsClassifierOnEveryTrimmedFac
     const scallop::CadImport imported = scallop::importCad(path, options);
     EXPECT_TRUE(imported.skipped.empty()) << sample.file << ": " << imported.skipped.front().reason;
     EXPECT_EQ(imported.faceTrims.size(), sample.trimmed) << sample.file;
-    // The same faces, read by OCCT alone in the importer's order, IGES B-splines as written.
-    scallop::test::quietOcct();
-    TopoDS_Shape shape;
-    if (sample.file.ends_with(".step")) {
-      STEPControl_Reader reader;
-      ASSERT_EQ(reader.ReadFile(path.c_str()), IFSelect_RetDone);
-      reader.TransferRoots();
-      shape = reader.OneShape();
-    } else {
-      const std::string saved = Interface_Static::CVal("read.iges.bspline.continuity");
-      Interface_Static::SetCVal("read.iges.bspline.continuity", "0");
-      IGESControl_Reader reader;
-      ASSERT_EQ(reader.ReadFile(path.c_str()), IFSelect_RetDone);
-      reader.TransferRoots();
-      shape = reader.OneShape();
-      Interface_Static::SetCVal("read.iges.bspline.continuity", saved.c_str());
-    }
-    std::vector<TopoDS_Face> faces;
-    for (TopExp_Explorer it(shape, TopAbs_FACE); it.More(); it.Next()) faces.push_back(TopoDS::Face(it.Current()));
+    const std::vector<TopoDS_Face> faces = occtFaces(path);
     ASSERT_EQ(faces.size(), imported.faces) << sample.file;
     for (const auto& [index, trim] : imported.faceTrims) {
       double u0 = 0.0, u1 = 0.0, v0 = 0.0, v1 = 0.0;
@@ -607,6 +612,64 @@ TEST(CadTrimmedSamples, TheArcsWindingAgreesWithOcctsClassifierOnEveryTrimmedFac
   std::printf("[          ] winding against OCCT's classifier: %zu points agree, %zu left out\n", compared, undecided);
   EXPECT_GT(compared, 170000u);
   EXPECT_LT(undecided, compared / 1000);
+}
+
+// Kept trims through each patch's map (face_trim.hpp's AxisMap: affine, or half-angles on the
+// converted cylinders, cones, spheres and tori): a point of a trimmed patch (a point of the
+// face's untrimmed surface) is kept exactly when it lies on the face, as OCCT's exact distance
+// from the point to the face says (BRepExtrema: 0 on the face, the distance to its boundary
+// off it), with no parameters at all.
+TEST(CadTrimmedSamples, KeptTrimsFollowTheFacesThroughEachPatchsMap) {
+  std::size_t compared = 0, undecided = 0, halfAngle = 0, trimmedPatches = 0;
+  for (const std::string file : {"step/screw.step", "step/linkrods.step", "iges/bearing.iges", "iges/hammer.iges"}) {
+    const std::string path = kOcctSamples + "/" + file;
+    if (!fs::exists(path)) GTEST_FAIL() << path << " is missing: Debian's occt-misc package installs it";
+    scallop::CadImportOptions options;
+    options.acceptTrimmed = options.keepTrims = true;
+    options.acceptRational = true;
+    options.skipUnsupportedFaces = true;
+    options.maxTrimPieces = 1000000;
+    options.trimSplit.normalSpreadRad = 8.0 * M_PI / 180.0;  // coarse pieces: only the kept patches matter
+    const scallop::CadImport imported = scallop::importCad(path, options);
+    // Every trimmed face is kept exactly: none is refused for its map.
+    for (const scallop::SkippedFace& skipped : imported.skipped)
+      ADD_FAILURE() << file << ": face " << skipped.face << " skipped: " << skipped.reason;
+    const std::vector<TopoDS_Face> faces = occtFaces(path);
+    ASSERT_EQ(faces.size(), imported.faces) << file;
+    const Surface& surface = imported.surface;
+    ASSERT_TRUE(surface.trimmed()) << file;
+    const double size = scallop::surfaceScale(surface);
+    for (std::size_t i = 0; i < surface.patches.size(); ++i) {
+      const scallop::PatchTrim& trim = surface.trims[i];
+      if (!trim.trimmed()) continue;
+      ++trimmedPatches;
+      halfAngle += trim.u.kind == scallop::AxisMap::Kind::halfAngle || trim.v.kind == scallop::AxisMap::Kind::halfAngle;
+      const TopoDS_Face& face = faces[imported.patchFaces[i]];
+      for (int a = 0; a < 6; ++a)
+        for (int b = 0; b < 6; ++b) {
+          const double s = (a + 0.37) / 6.0, t = (b + 0.61) / 6.0;
+          const Vec3 p = scallop::point(surface.patches[i], s, t);
+          BRepExtrema_DistShapeShape distance(BRepBuilderAPI_MakeVertex(gp_Pnt(p.x, p.y, p.z)).Vertex(), face);
+          ASSERT_TRUE(distance.IsDone()) << file << " patch " << i;
+          const CellPlace place = scallop::classifyPoint(*trim.face, trim.u.at(s), trim.v.at(t));
+          const bool onFace = distance.Value() <= 1e-9 * size, offFace = distance.Value() > 1e-6 * size;
+          if (place == CellPlace::boundary || (!onFace && !offFace)) {
+            ++undecided;
+            continue;
+          }
+          EXPECT_EQ(scallop::keepsPoint(trim, s, t), onFace)
+              << file << " patch " << i << " (face " << imported.patchFaces[i] << ") at (" << s << ", " << t
+              << "): " << distance.Value() << " from the face";
+          ++compared;
+        }
+    }
+  }
+  std::printf("[          ] kept trims against OCCT's distance to the face: %zu trimmed patches (%zu by half-angles), "
+              "%zu points agree, %zu left out\n",
+              trimmedPatches, halfAngle, compared, undecided);
+  EXPECT_GE(halfAngle, 10u);  // 13: the screw's cones and tori, the linkrods' cylinders
+  EXPECT_GT(compared, 7000u);
+  EXPECT_LT(undecided, compared / 50);
 }
 
 // --- exact heights ----------------------------------------------------------------------------

@@ -4,17 +4,22 @@
 // its parameter square, or to the square minus a disk (a hole), the map to the face's
 // parameters affine (scaled, shifted, u reversed), so every reference is in closed form or
 // by dense sampling written here: the disk's membership of a point, the circle's parameters,
-// brute-force distances over the disk and along its circle.
+// brute-force distances over the disk and along its circle. A second face, an arch (a
+// cylinder's rational quadratic arc, its weights not in standard form, trimmed in the face's
+// (angle, height)), takes the half-angle map (face_trim.hpp's AxisMap): its references read
+// the angle off each 3D point with atan2, not through the map.
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <numbers>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "scallop/bezier.hpp"
@@ -80,7 +85,7 @@ struct TrimmedPaper {
     }
     PatchTrim trim;
     trim.face = face;
-    trim.u0 = 10.0, trim.u1 = 6.0, trim.v0 = 2.0, trim.v1 = 6.0;
+    trim.u = scallop::AxisMap::affine(10.0, 6.0), trim.v = scallop::AxisMap::affine(2.0, 6.0);
     trim.margin = 1e-12;
     surface.trims = {trim};
   }
@@ -90,12 +95,134 @@ struct TrimmedPaper {
     const double d = kRadius - std::hypot(s - kCentreS, t - kCentreT);
     return hole ? -d : d;
   }
+
+  // The circle's point at angle a, pulled into the face by `inward` (patch parameters).
+  std::pair<double, double> boundary(double a, double inward) const {
+    const double r = kRadius + (hole ? inward : -inward);
+    return {kCentreS + r * std::cos(a), kCentreT + r * std::sin(a)};
+  }
+  // Where the section planes pass and the query points lie.
+  Vec3 middle() const { return {1.5, 1.35, 0.6}; }
+  Vec3 randomPoint(std::mt19937_64& rng) const {
+    std::uniform_real_distribution<double> across(-0.5, 3.5), up(-1.0, 2.5);
+    return {across(rng), across(rng), up(rng)};
+  }
+  double queryReach() const { return 3.5; }  // the query points' largest coordinate
 };
 
-// The paper surface's point over (x, y) = (3 t, 3 s): on paper-1, r(s, t) = (3 t, 3 s, z(s, t)).
-TEST(TrimmedSurface, SectionsStopAtTheTrimmingCurve) {
+// The arch: a cylinder of radius 2 about the y axis, r(s, t) = (2 cos a, 3 t, 2 sin a) for
+// the angle a from 40 to 140 degrees, s along the arc as a rational quadratic with weights
+// (1, 1.7 cos 50 deg, 1.7^2) (a Moebius reparametrisation of the standard form, so s is
+// neither the angle nor its standard half-angle parameter). The face's parameters are
+// (u, v) = (a, y); its trim is the disk |(u, v) - (pi / 2, 1.5)| <= 0.6, or the rectangle
+// minus it (`hole` true).
+struct TrimmedArch {
+  Surface surface;
+  bool hole = false;
+  static constexpr double kRadius = 0.6, kCentreV = 1.5, kRho = 2.0, kWeightScale = 1.7;
+  static constexpr double kStart = 40.0 * std::numbers::pi / 180.0, kEnd = 140.0 * std::numbers::pi / 180.0;
+  static constexpr double kCentreU = std::numbers::pi / 2.0;
+
+  explicit TrimmedArch(bool withHole) : hole(withHole) {
+    scallop::BezierPatch patch;
+    patch.degreeU = 2, patch.degreeV = 1;
+    const double half = 0.5 * (kEnd - kStart), middle = 0.5 * (kStart + kEnd);
+    const Vec3 rim[3] = {{kRho * std::cos(kStart), 0.0, kRho * std::sin(kStart)},
+                         {kRho / std::cos(half) * std::cos(middle), 0.0, kRho / std::cos(half) * std::sin(middle)},
+                         {kRho * std::cos(kEnd), 0.0, kRho * std::sin(kEnd)}};
+    const double weights[3] = {1.0, kWeightScale * std::cos(half), kWeightScale * kWeightScale};
+    for (int a = 0; a <= 2; ++a)
+      for (int b = 0; b <= 1; ++b) {
+        patch.control.push_back(rim[a] + Vec3{0.0, 3.0 * b, 0.0});
+        patch.weights.push_back(weights[a]);
+      }
+    surface.units = scallop::Units::millimetre;
+    surface.patches = {patch};
+    auto face = std::make_shared<FaceTrim>();
+    if (hole) {
+      const double corners[4][2] = {{kStart, 0}, {kEnd, 0}, {kEnd, 3}, {kStart, 3}};
+      for (int i = 0; i < 4; ++i)
+        face->arcs.push_back(
+            TrimArc{{corners[i][0], corners[i][1], 1.0}, {corners[(i + 1) % 4][0], corners[(i + 1) % 4][1], 1.0}});
+      for (const TrimArc& arc : circleArcs(kCentreU, kCentreV, kRadius, true)) face->arcs.push_back(arc);
+    } else {
+      face->arcs = circleArcs(kCentreU, kCentreV, kRadius, false);
+    }
+    PatchTrim trim;
+    trim.face = face;
+    // The map through the angles of the patch's points at s = 0, 1/2, 1, read off with atan2
+    // (as cad_import.cpp reads OCCT's parameters of them).
+    trim.u = scallop::AxisMap::halfAngle(angleAt(0.0), angleAt(0.5), angleAt(1.0));
+    trim.v = scallop::AxisMap::affine(0.0, 3.0);
+    trim.margin = 1e-12;
+    surface.trims = {trim};
+  }
+
+  // The angle of the patch's point at s (any t), from the point itself.
+  double angleAt(double s) const {
+    const Vec3 p = scallop::point(surface.patches[0], s, 0.5);
+    return std::atan2(p.z, p.x);
+  }
+  double signedDistance(double s, double t) const {  // > 0 inside the face
+    const Vec3 p = scallop::point(surface.patches[0], s, t);
+    const double d = kRadius - std::hypot(std::atan2(p.z, p.x) - kCentreU, p.y - kCentreV);
+    return hole ? -d : d;
+  }
+  // The circle's point at angle a, pulled into the face by `inward` (face parameters): s by
+  // bisection on the angle of the patch's points (it increases with s).
+  std::pair<double, double> boundary(double a, double inward) const {
+    const double r = kRadius + (hole ? inward : -inward);
+    const double u = kCentreU + r * std::cos(a), v = kCentreV + r * std::sin(a);
+    double lo = 0.0, hi = 1.0;
+    for (int k = 0; k < 60; ++k) {
+      const double mid = 0.5 * (lo + hi);
+      (angleAt(mid) < u ? lo : hi) = mid;
+    }
+    return {0.5 * (lo + hi), v / 3.0};
+  }
+  Vec3 middle() const { return {0.0, 1.5, 1.9}; }
+  Vec3 randomPoint(std::mt19937_64& rng) const {
+    // Most near the disk's part of the arch, so that the trim matters to many of them.
+    std::uniform_real_distribution<double> across(-2.0, 2.0), along(0.3, 2.7), up(0.3, 3.2);
+    return {across(rng), along(rng), up(rng)};
+  }
+  double queryReach() const { return 3.5; }
+};
+
+// The half-angle map against the angle read off the patch's points; the patch's membership
+// (keepsPoint) against the closed form, beyond a band of 1e-9.
+TEST(TrimmedSurface, AHalfAngleMapIsTheAngleOfTheArcsPoints) {
+  const TrimmedArch arch(false);
+  const PatchTrim& trim = arch.surface.trims[0];
+  double worst = 0.0;
+  for (int i = 0; i <= 10000; ++i) {
+    const double s = i / 10000.0;
+    worst = std::max(worst, std::abs(trim.u.at(s) - arch.angleAt(s)));
+  }
+  EXPECT_LE(worst, 1e-13);
+  // Not the affine map through the ends: the weights make s far from the angle's fraction.
+  EXPECT_GT(std::abs(trim.u.at(0.5) - 0.5 * (TrimmedArch::kStart + TrimmedArch::kEnd)), 0.1);
   for (const bool hole : {false, true}) {
-    const TrimmedPaper trimmed(hole);
+    const TrimmedArch trimmed(hole);
+    int inside = 0, outside = 0;
+    for (int a = 0; a <= 400; ++a)
+      for (int b = 0; b <= 400; ++b) {
+        const double s = (a + 0.3) / 400.7, t = (b + 0.6) / 400.7;
+        const double margin = trimmed.signedDistance(s, t);
+        if (std::abs(margin) < 1e-9) continue;
+        EXPECT_EQ(scallop::keepsPoint(trimmed.surface.trims[0], s, t), margin > 0.0) << s << ", " << t;
+        (margin > 0.0 ? inside : outside) += 1;
+      }
+    EXPECT_GT(inside, 20000) << hole;
+    EXPECT_GT(outside, 20000) << hole;
+  }
+}
+
+// The paper surface's point over (x, y) = (3 t, 3 s): on paper-1, r(s, t) = (3 t, 3 s, z(s, t)).
+template <typename Case>
+void checkSectionsStopAtTheTrimmingCurve(const Case& trimmed) {
+  const bool hole = trimmed.hole;
+  {
     Surface untrimmed = trimmed.surface;
     untrimmed.trims.clear();
     int ends = 0, samples = 0;
@@ -103,7 +230,7 @@ TEST(TrimmedSurface, SectionsStopAtTheTrimmingCurve) {
       // Planes of several directions through the surface.
       const double angle = 0.3 + 0.25 * k;
       const Vec3 normal{std::cos(angle), std::sin(angle), k % 3 == 0 ? 0.0 : 0.4};
-      const double offset = dot(normal, Vec3{1.5, 1.35, 0.6}) + 0.05 * (k % 5 - 2);
+      const double offset = dot(normal, trimmed.middle()) + 0.05 * (k % 5 - 2);
       const scallop::PlaneSection cut = scallop::planeSection(trimmed.surface, normal, offset, 1e-5);
       const scallop::PlaneSection whole = scallop::planeSection(untrimmed, normal, offset, 1e-5);
       // Every vertex in the face (the curves' ends on the circle, within 1e-9).
@@ -143,10 +270,19 @@ TEST(TrimmedSurface, SectionsStopAtTheTrimmingCurve) {
   }
 }
 
+TEST(TrimmedSurface, SectionsStopAtTheTrimmingCurve) {
+  for (const bool hole : {false, true}) checkSectionsStopAtTheTrimmingCurve(TrimmedPaper(hole));
+}
+
+TEST(TrimmedSurface, SectionsOfAHalfAngleTrimStopAtItsCurve) {
+  for (const bool hole : {false, true}) checkSectionsStopAtTheTrimmingCurve(TrimmedArch(hole));
+}
+
 // The distance to the trimmed face against brute force over it: a 300 x 300 grid of the
 // square kept where the disk test passes, plus 20,000 points of the circle, the best refined
 // by a pattern search that stays in the face (a step leaving it is refused).
-double referenceDistance(const TrimmedPaper& trimmed, Vec3 p) {
+template <typename Case>
+double referenceDistance(const Case& trimmed, const std::vector<std::pair<double, double>>& circle, Vec3 p) {
   const scallop::BezierPatch& patch = trimmed.surface.patches[0];
   struct Start {
     double d, s, t;
@@ -158,12 +294,7 @@ double referenceDistance(const TrimmedPaper& trimmed, Vec3 p) {
   };
   for (int i = 0; i <= 300; ++i)
     for (int k = 0; k <= 300; ++k) consider(i / 300.0, k / 300.0);
-  for (int i = 0; i < 20000; ++i) {
-    const double a = 2.0 * std::numbers::pi * i / 20000.0;
-    // Just inside the face: on the circle, pulled in by 1e-13.
-    const double r = TrimmedPaper::kRadius + (trimmed.hole ? 1e-13 : -1e-13);
-    consider(TrimmedPaper::kCentreS + r * std::cos(a), TrimmedPaper::kCentreT + r * std::sin(a));
-  }
+  for (const auto& [s, t] : circle) consider(s, t);
   std::partial_sort(starts.begin(), starts.begin() + 6, starts.end(),
                     [](const Start& a, const Start& b) { return a.d < b.d; });
   double best = starts.front().d;
@@ -185,24 +316,27 @@ double referenceDistance(const TrimmedPaper& trimmed, Vec3 p) {
   return best;
 }
 
-TEST(TrimmedSurface, DistancesAreToTheFaceAlone) {
-  std::mt19937_64 rng(1414);
-  std::uniform_real_distribution<double> across(-0.5, 3.5), up(-1.0, 2.5);
-  for (const bool hole : {false, true}) {
-    const TrimmedPaper trimmed(hole);
+template <typename Case>
+void checkDistancesAreToTheFaceAlone(const Case& trimmed, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  const bool hole = trimmed.hole;
+  // 20,000 points of the circle, just inside the face (pulled in by 1e-13).
+  std::vector<std::pair<double, double>> circle;
+  for (int i = 0; i < 20000; ++i) circle.push_back(trimmed.boundary(2.0 * std::numbers::pi * i / 20000.0, 1e-13));
+  {
     const scallop::SurfaceDistance engine(trimmed.surface);
     Surface untrimmed = trimmed.surface;
     untrimmed.trims.clear();
     const scallop::SurfaceDistance whole(untrimmed);
     int fartherThanUntrimmed = 0;
     for (int i = 0; i < 120; ++i) {
-      const Vec3 p{across(rng), across(rng), up(rng)};
+      const Vec3 p = trimmed.randomPoint(rng);
       const scallop::ClosestPoint found = engine.closest(p);
       ASSERT_TRUE(found.converged) << i;
-      const double reference = referenceDistance(trimmed, p);
+      const double reference = referenceDistance(trimmed, circle, p);
       // The reference is a point of the face: an upper bound; its refinement reaches 1e-9.
       // Beside a trimming curve the search resolves the face to kTrimCellReach of its scale.
-      const double reach = engine.tolerance() + scallop::kTrimCellReach * (scallop::surfaceScale(trimmed.surface) + 3.5);
+      const double reach = engine.tolerance() + scallop::kTrimCellReach * (scallop::surfaceScale(trimmed.surface) + trimmed.queryReach());
       EXPECT_LE(found.distance, reference + reach) << "hole " << hole << " point " << i << " excess "
                                                    << found.distance - reference;
       EXPECT_GE(found.distance, reference - 1e-7) << "hole " << hole << " point " << i;
@@ -217,6 +351,14 @@ TEST(TrimmedSurface, DistancesAreToTheFaceAlone) {
     }
     EXPECT_GT(fartherThanUntrimmed, 10) << hole;  // the trim matters to many of the points
   }
+}
+
+TEST(TrimmedSurface, DistancesAreToTheFaceAlone) {
+  for (const bool hole : {false, true}) checkDistancesAreToTheFaceAlone(TrimmedPaper(hole), 1414);
+}
+
+TEST(TrimmedSurface, DistancesToAHalfAngleTrimAreToTheFaceAlone) {
+  for (const bool hole : {false, true}) checkDistancesAreToTheFaceAlone(TrimmedArch(hole), 1415);
 }
 
 // The simulated cut's design: over (x, y) = (3 t, 3 s) the surface's height where the face
@@ -250,6 +392,37 @@ TEST(TrimmedSurface, TheDesignIsTheFaceAlone) {
   }
 }
 
+// The arch's design over (x, y): the cylinder's height sqrt(4 - x^2) where the angle
+// acos(x / 2) and y put the point in the face, nothing elsewhere.
+TEST(TrimmedSurface, TheDesignOfAHalfAngleTrimIsTheFaceAlone) {
+  for (const bool hole : {false, true}) {
+    const TrimmedArch trimmed(hole);
+    scallop::HeightGrid grid;
+    grid.x0 = -1.8, grid.y0 = -0.1, grid.spacing = 0.02, grid.columns = 181, grid.rows = 161;
+    grid.z.assign(grid.columns * grid.rows, -kInf);
+    scallop::designHeights(trimmed.surface, grid, nullptr);
+    int inside = 0, outside = 0;
+    for (std::size_t j = 0; j < grid.rows; ++j)
+      for (std::size_t i = 0; i < grid.columns; ++i) {
+        const scallop::Vec2 at = grid.point(i, j);
+        const double z = grid.z[j * grid.columns + i];
+        const double angle = std::acos(std::clamp(at.x / TrimmedArch::kRho, -1.0, 1.0));
+        const bool inSquare = angle >= TrimmedArch::kStart && angle <= TrimmedArch::kEnd && at.y >= 0.0 && at.y <= 3.0;
+        double margin = TrimmedArch::kRadius - std::hypot(angle - TrimmedArch::kCentreU, at.y - TrimmedArch::kCentreV);
+        if (hole) margin = -margin;
+        if (!inSquare || margin < -1e-9) {
+          EXPECT_EQ(z, -kInf) << at.x << ", " << at.y;
+          ++outside;
+        } else if (margin > 1e-9 && std::abs(at.x) < TrimmedArch::kRho * std::cos(TrimmedArch::kStart) - 1e-9) {
+          EXPECT_NEAR(z, std::sqrt(TrimmedArch::kRho * TrimmedArch::kRho - at.x * at.x), 1e-9) << at.x << ", " << at.y;
+          ++inside;
+        }
+      }
+    EXPECT_GT(inside, 3000) << hole;
+    EXPECT_GT(outside, 3000) << hole;
+  }
+}
+
 // What a trimmed surface must be, and what it cannot be written as.
 TEST(TrimmedSurface, TrimsAreCheckedAndHaveNoJsonForm) {
   TrimmedPaper trimmed(false);
@@ -267,8 +440,19 @@ TEST(TrimmedSurface, TrimsAreCheckedAndHaveNoJsonForm) {
   two.patches.push_back(two.patches[0]);  // two patches, one trim
   EXPECT_NE(message([&] { scallop::validateSurface(two); }).find("trims: 1 for 2 patches"), std::string::npos);
   Surface flat = trimmed.surface;
-  flat.trims[0].v1 = flat.trims[0].v0;  // maps the square onto a segment
-  EXPECT_NE(message([&] { scallop::validateSurface(flat); }).find("not a rectangle"), std::string::npos);
+  flat.trims[0].v.to = flat.trims[0].v.from;  // maps the square onto a segment
+  EXPECT_NE(message([&] { scallop::validateSurface(flat); }).find("patches[0]: its trim's v: maps [0, 1] onto [2, 2]"),
+            std::string::npos);
+  TrimmedArch arch(false);
+  EXPECT_NO_THROW(scallop::validateSurface(arch.surface));
+  Surface pole = arch.surface;
+  pole.trims[0].u.offset = -0.25 * pole.trims[0].u.slope;  // the denominator vanishes at s = 1/4
+  EXPECT_NE(message([&] { scallop::validateSurface(pole); }).find("its trim's u: maps [0, 1] onto"), std::string::npos);
+  // Angles that are not a monotone arc of less than a turn have no half-angle map.
+  EXPECT_NE(message([] { (void)scallop::AxisMap::halfAngle(0.0, 1.0, 0.5); }).find("not a monotone arc"),
+            std::string::npos);
+  EXPECT_NE(message([] { (void)scallop::AxisMap::halfAngle(0.0, 3.5, 7.0); }).find("not a monotone arc"),
+            std::string::npos);
 }
 
 }  // namespace

@@ -124,13 +124,15 @@ struct CadImportOptions {
   /// "trimmed faces"). The other computations take untrimmed faces only.
   bool acceptTrimmed = false;
   /// With acceptTrimmed: a trimmed face's patches that meet it are kept whole, each with its
-  /// trim (surface.hpp's trims: the face's arcs and the affine map of its parameters), instead
-  /// of as pieces; for `plan`, `paths` and `verify`, whose sections, distances and simulated
-  /// cut then take exactly the face's part. A face whose patches' parameters do not map
-  /// affinely onto the face's (cylinders, cones, spheres, tori, revolutions: the angle is
-  /// not a rational function of the B-spline's parameter) is refused as "trimmed". The
-  /// pieces are still made, for the budget and to check the patches are regular where the
-  /// face is.
+  /// trim (surface.hpp's trims: the face's arcs and the map of its parameters), instead of as
+  /// pieces; for `plan`, `paths` and `verify`, whose sections, distances and simulated cut
+  /// then take exactly the face's part. Each patch parameter maps onto the face's either
+  /// affinely (B-spline and Bezier faces, planes, the heights of cylinders and cones) or by
+  /// half-angles (face_trim.hpp's AxisMap: the angles of cylinders, cones, spheres, tori and
+  /// revolutions, whose OCCT conversions are rational quadratic circles), fitted and checked
+  /// against OCCT's parameters at nine points; a face where neither fits is refused as
+  /// "trimmed". The pieces are still made, for the budget and to check the patches are
+  /// regular where the face is.
   bool keepTrims = false;
   /// How finely boundary pieces follow the trimming curves (per patch).
   TrimSplitOptions trimSplit{};

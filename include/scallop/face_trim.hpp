@@ -91,17 +91,47 @@ CellPlace classifyPoint(const FaceTrim& trim, double u, double v);
 /// Where the box lies with respect to the face's trim (see the contract).
 CellPlace classifyBox(const FaceTrim& trim, const ParameterBox& box);
 
-/// A Bezier patch of a trimmed face: the face's trim, shared by its patches, and the affine
-/// map from the patch's parameters (s, t) in [0, 1]^2 to the face's,
-///   u = u0 + s (u1 - u0),  v = v0 + t (v1 - v0)
-/// (u1 < u0 where the patch runs against the face's u, as a REVERSED face's patches do).
-/// Exact for the patches of B-spline and Bezier faces (a patch is a knot span of the face's
-/// B-spline, whose parameters are the face's). Without a face the patch is not trimmed.
-/// The patch is the part of its square whose image lies in the face (classifyPoint: inside,
-/// or on a trimming curve).
+/// One of a face's parameters as a function of one of its patch's, x in [0, 1], monotone.
+/// The other patch parameter does not enter: the faces this serves are B-spline and Bezier
+/// faces (a patch is a knot span of the face's own parameters) and the kinds OCCT converts to
+/// rational B-splines as tensor products (cylinders, cones, spheres, tori, revolutions: u the
+/// angle about the axis, v along the generatrix).
+///  - affine: from + x (to - from).
+///  - halfAngle: middle + 2 atan((x - 1/2) / (slope x + offset)), radians: the angle of a
+///    point of a circular arc given as a rational quadratic Bezier curve with parameter x.
+///    Why this form: every proper parametrisation of a conic by rational quadratics is a
+///    linear fractional (Moebius) reparametrisation of any other, in particular of the
+///    standard q -> ((1 - q^2), 2 q) / (1 + q^2) with q = tan(angle / 2); and tan((a - m) / 2)
+///    is itself a Moebius function of tan(a / 2). So tan((angle - middle) / 2) is a Moebius
+///    function of x that vanishes at x = 1/2, (x - 1/2) / (slope x + offset), fixed by the
+///    angles at the ends (halfAngle(from, middle, to)). It is monotone on [0, 1] when its
+///    denominator keeps one sign there (validateAxisMap).
+/// cad_import.cpp fits the map through three points and checks it at six more against
+/// OpenCASCADE's own parameters of the patch's points.
+struct AxisMap {
+  enum class Kind { affine, halfAngle };
+  Kind kind = Kind::affine;
+  double from = 0.0, to = 1.0;                     // the values at x = 0 and x = 1
+  double middle = 0.0, slope = 0.0, offset = 0.0;  // halfAngle: the value at 1/2, the denominator
+  double at(double x) const;
+  static AxisMap affine(double from, double to);
+  /// The arc's angles (radians) at x = 0, 1/2 and 1; each end within pi of the middle and on
+  /// the other side of it from the other end (else not a monotone arc: throws Error).
+  static AxisMap halfAngle(double from, double middle, double to);
+};
+
+/// Throws Error (naming `what`) unless the map is finite, not constant and monotone on [0, 1].
+void validateAxisMap(const AxisMap& map, const char* what);
+
+/// A Bezier patch of a trimmed face: the face's trim, shared by its patches, and the map from
+/// the patch's parameters (s, t) in [0, 1]^2 to the face's, u = u.at(s), v = v.at(t) (each
+/// decreasing where the patch runs against the face's parameter, as a REVERSED face's patches
+/// do). Without a face the patch is not trimmed. The patch is the part of its square whose
+/// image lies in the face (classifyPoint: inside, or on a trimming curve). A cell of the
+/// square maps onto the box of its corners' images (each map monotone).
 struct PatchTrim {
   std::shared_ptr<const FaceTrim> face;
-  double u0 = 0.0, u1 = 1.0, v0 = 0.0, v1 = 1.0;
+  AxisMap u, v;
   /// Boxes are widened by this in the face's parameters before they are classified: the
   /// rounding of the map and of the arcs' halving (cad_import.cpp: 1e-8 of the face's
   /// rectangle).
