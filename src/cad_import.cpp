@@ -535,7 +535,7 @@ class PieceParameters {
   // face's affinely (B-spline and Bezier faces: the identity up to the period; planes; the
   // heights of cylinders and cones) or, on a converted face, by half-angles (the angles of
   // OCCT's rational quadratic circles): fitted through the ends and the middle, and checked
-  // at six more points against OCCT's parameters of the patch's points (kAxisMapFit of the
+  // at the seven inner eighths against OCCT's parameters of the patch's points (kAxisMapFit of the
   // span); nullopt when neither fits.
   std::optional<PatchTrim> patchTrim(std::shared_ptr<const FaceTrim> face) {
     const auto atS = [&](double s) { return faceU(knotU0_ + (reversed_ ? 1.0 - s : s) * (knotU1_ - knotU0_)); };

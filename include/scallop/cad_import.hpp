@@ -129,10 +129,10 @@ struct CadImportOptions {
   /// then take exactly the face's part. Each patch parameter maps onto the face's either
   /// affinely (B-spline and Bezier faces, planes, the heights of cylinders and cones) or by
   /// half-angles (face_trim.hpp's AxisMap: the angles of cylinders, cones, spheres, tori and
-  /// revolutions, whose OCCT conversions are rational quadratic circles), fitted and checked
-  /// against OCCT's parameters at nine points; a face where neither fits is refused as
-  /// "trimmed". The pieces are still made, for the budget and to check the patches are
-  /// regular where the face is.
+  /// revolutions, whose OCCT conversions are rational quadratic circles), fitted through
+  /// three points and checked against OCCT's parameters at the seven inner eighths; a face
+  /// where neither fits is refused as "trimmed". The pieces are still made, for the budget
+  /// and to check the patches are regular where the face is.
   bool keepTrims = false;
   /// How finely boundary pieces follow the trimming curves (per patch).
   TrimSplitOptions trimSplit{};

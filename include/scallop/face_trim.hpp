@@ -106,8 +106,8 @@ CellPlace classifyBox(const FaceTrim& trim, const ParameterBox& box);
 ///    function of x that vanishes at x = 1/2, (x - 1/2) / (slope x + offset), fixed by the
 ///    angles at the ends (halfAngle(from, middle, to)). It is monotone on [0, 1] when its
 ///    denominator keeps one sign there (validateAxisMap).
-/// cad_import.cpp fits the map through three points and checks it at six more against
-/// OpenCASCADE's own parameters of the patch's points.
+/// cad_import.cpp fits the map through x = 0, 1/2 and 1 and checks it at the seven inner
+/// eighths against OpenCASCADE's own parameters of the patch's points.
 struct AxisMap {
   enum class Kind { affine, halfAngle };
   Kind kind = Kind::affine;
