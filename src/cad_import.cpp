@@ -829,6 +829,22 @@ CadImport importCad(const std::string& path, CadFormat format, const CadImportOp
   return result;
 }
 
+namespace {
+
+// How far a face's edges may stand off its neighbours' (surface.hpp's seamTolerances): the
+// largest tolerance of the face, its edges and its vertices (OCCT keeps tolerance(face) <=
+// tolerance(edge) <= tolerance(vertex), but files do not always respect it).
+double faceSeamTolerance(const TopoDS_Face& face) {
+  double tolerance = BRep_Tool::Tolerance(face);
+  for (TopExp_Explorer it(face, TopAbs_EDGE); it.More(); it.Next())
+    tolerance = std::max(tolerance, BRep_Tool::Tolerance(TopoDS::Edge(it.Current())));
+  for (TopExp_Explorer it(face, TopAbs_VERTEX); it.More(); it.Next())
+    tolerance = std::max(tolerance, BRep_Tool::Tolerance(TopoDS::Vertex(it.Current())));
+  return std::isfinite(tolerance) ? tolerance : 0.0;
+}
+
+}  // namespace
+
 namespace detail {
 
 CadImport convertFaces(const CadFile& transferred, const std::string& path, const CadImportOptions& options,
@@ -855,7 +871,9 @@ CadImport convertFaces(const CadFile& transferred, const std::string& path, cons
                                                       : std::string(),
                                       detail::occtMessage(failure))};
       }
+      const double seam = faceSeamTolerance(face);
       for (std::size_t p = 0; p < patches.patches.size(); ++p) {
+        result.surface.seamTolerances.push_back(seam);
         result.surface.patches.push_back(std::move(patches.patches[p]));
         result.patchFaces.push_back(index);
         result.patchRoles.push_back(patches.roles[p]);

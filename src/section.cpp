@@ -387,7 +387,12 @@ void clipPiece(const Piece& piece, const BezierPatch& patch, const PatchTrim& tr
   if (current.size() >= 2) out.push_back(std::move(current));
 }
 
-void joinPieces(std::vector<Piece> pieces, double joinTolerance, PlaneSection& out) {
+// Two ends are one node when they are within joinTolerance, or, on patches of a CAD model,
+// within kSeamJoinFactor times the larger of their patches' seam tolerances (surface.hpp) but
+// no farther than the chordal tolerance: the joining chord then stands no farther from the
+// true curve than the traced chords do.
+void joinPieces(std::vector<Piece> pieces, double joinTolerance, double chordalTolerance, const Surface& surface,
+                PlaneSection& out) {
   const std::size_t count = pieces.size();
   if (count == 0) return;
   // Cluster the 2 count ends (end 2i is piece i's first point, 2i + 1 its last).
@@ -397,14 +402,21 @@ void joinPieces(std::vector<Piece> pieces, double joinTolerance, PlaneSection& o
     const Piece& p = pieces[e / 2];
     return (e % 2 == 0 ? p.front() : p.back()).point;
   };
+  auto endSeam = [&](std::size_t e) {
+    const Piece& p = pieces[e / 2];
+    return std::min(chordalTolerance,
+                    kSeamJoinFactor * seamTolerance(surface, (e % 2 == 0 ? p.front() : p.back()).patch));
+  };
+  double widest = 0.0;
+  for (std::size_t e = 0; e < 2 * count; ++e) widest = std::max(widest, endSeam(e));
   std::sort(order.begin(), order.end(),
             [&](std::size_t a, std::size_t b) { return endPoint(a).x < endPoint(b).x; });
   DisjointSets ends(2 * count);
   for (std::size_t i = 0; i < order.size(); ++i) {
     for (std::size_t j = i + 1; j < order.size(); ++j) {
-      if (endPoint(order[j]).x - endPoint(order[i]).x > joinTolerance) break;
-      if (norm(endPoint(order[j]) - endPoint(order[i])) <= joinTolerance)
-        ends.unite(order[i], order[j]);
+      if (endPoint(order[j]).x - endPoint(order[i]).x > std::max(joinTolerance, widest)) break;
+      const double reach = std::max({joinTolerance, endSeam(order[i]), endSeam(order[j])});
+      if (norm(endPoint(order[j]) - endPoint(order[i])) <= reach) ends.unite(order[i], order[j]);
     }
   }
   std::vector<std::size_t> node(2 * count);
@@ -494,7 +506,7 @@ PlaneSection planeSection(const Surface& surface, const Vec3& normal, double off
       if (keepsPoint(*trim, touch.u, touch.v)) out.touchPoints.push_back(touch);
   }
   const double scale = std::max(surfaceScale(surface), 1e-300);
-  joinPieces(std::move(pieces), kJoinTolerance * scale, out);
+  joinPieces(std::move(pieces), kJoinTolerance * scale, chordalTolerance, surface, out);
   return out;
 }
 

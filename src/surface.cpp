@@ -904,7 +904,14 @@ void validateSurface(const Surface& surface) {
   if (surface.trimmed() && surface.trims.size() != surface.patches.size())
     throw Error(fmt::format("trims: {} for {} patches; one per patch or none", surface.trims.size(),
                             surface.patches.size()));
+  if (!surface.seamTolerances.empty() && surface.seamTolerances.size() != surface.patches.size())
+    throw Error(fmt::format("seam tolerances: {} for {} patches; one per patch or none",
+                            surface.seamTolerances.size(), surface.patches.size()));
   for (std::size_t i = 0; i < surface.patches.size(); ++i) {
+    if (!surface.seamTolerances.empty() &&
+        !(surface.seamTolerances[i] >= 0.0 && std::isfinite(surface.seamTolerances[i])))
+      throw Error(fmt::format("{}: its seam tolerance {} is not a finite non-negative number", patchPath(i),
+                              surface.seamTolerances[i]));
     const PatchTrim* const trimmed = patchTrim(surface, i);
     if (trimmed) {
       const PatchTrim& trim = *trimmed;

@@ -309,6 +309,7 @@ Surface selectPatches(const Surface& surface, std::span<const std::size_t> indic
     }
     selected.patches.push_back(surface.patches[i]);
     if (surface.trimmed()) selected.trims.push_back(surface.trims[i]);  // a trimmed patch keeps its trim
+    if (!surface.seamTolerances.empty()) selected.seamTolerances.push_back(surface.seamTolerances[i]);
   }
   return selected;
 }

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include <BRep_Tool.hxx>
 #include <BRepAlgoAPI_Cut.hxx>
 #include <BRepBuilderAPI_MakeEdge.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
@@ -53,6 +54,7 @@
 #include "scallop/gouge.hpp"
 #include "scallop/mesh_slicing.hpp"
 #include "scallop/optimal_slicing.hpp"
+#include "scallop/section.hpp"
 #include "scallop/surface_io.hpp"
 
 namespace {
@@ -670,6 +672,64 @@ TEST(CadTrimmedSamples, KeptTrimsFollowTheFacesThroughEachPatchsMap) {
   EXPECT_GE(halfAngle, 10u);  // 13: the screw's cones and tori, the linkrods' cylinders
   EXPECT_GT(compared, 7000u);
   EXPECT_LT(undecided, compared / 50);
+}
+
+// Seams (section.hpp's seam joins): the screw is a closed solid, so every plane section of
+// it is closed loops. Its faces meet only to the model's tolerance (up to 3e-4 mm): each
+// patch carries its face's largest tolerance (recomputed here from OCCT's faces), and with it
+// every section by 14 planes in each of three directions is closed loops; without it, some
+// stop at the seams.
+TEST(CadTrimmedSamples, SectionsOfTheClosedScrewAreClosedLoopsAcrossItsSeams) {
+  const std::string path = kOcctSamples + "/step/screw.step";
+  if (!fs::exists(path)) GTEST_FAIL() << path << " is missing: Debian's occt-misc package installs it";
+  scallop::CadImportOptions options;
+  options.acceptTrimmed = options.keepTrims = options.acceptRational = true;
+  options.trimSplit.normalSpreadRad = 8.0 * M_PI / 180.0;
+  scallop::CadImport imported = scallop::importCad(path, options);
+  Surface& surface = imported.surface;
+  const std::vector<TopoDS_Face> faces = occtFaces(path);
+  ASSERT_EQ(faces.size(), imported.faces);
+  ASSERT_EQ(surface.seamTolerances.size(), surface.patches.size());
+  for (std::size_t i = 0; i < surface.patches.size(); ++i) {
+    const TopoDS_Face& face = faces[imported.patchFaces[i]];
+    double tolerance = BRep_Tool::Tolerance(face);
+    for (TopExp_Explorer it(face, TopAbs_VERTEX); it.More(); it.Next())
+      tolerance = std::max(tolerance, BRep_Tool::Tolerance(TopoDS::Vertex(it.Current())));
+    for (TopExp_Explorer it(face, TopAbs_EDGE); it.More(); it.Next())
+      tolerance = std::max(tolerance, BRep_Tool::Tolerance(TopoDS::Edge(it.Current())));
+    EXPECT_EQ(surface.seamTolerances[i], tolerance) << "patch " << i;
+  }
+  const double size = scallop::surfaceScale(surface);
+  double low[3], high[3];
+  for (int axis = 0; axis < 3; ++axis) low[axis] = std::numeric_limits<double>::infinity(), high[axis] = -low[axis];
+  for (const scallop::BezierPatch& patch : surface.patches)
+    for (const Vec3& p : patch.control) {
+      const double c[3] = {p.x, p.y, p.z};
+      for (int axis = 0; axis < 3; ++axis) low[axis] = std::min(low[axis], c[axis]), high[axis] = std::max(high[axis], c[axis]);
+    }
+  const std::vector<double> tolerances = surface.seamTolerances;
+  std::size_t curves = 0, openWithout = 0;
+  for (int axis = 0; axis < 3; ++axis)
+    for (int k = 0; k < 14; ++k) {
+      Vec3 normal{0, 0, 0};
+      (axis == 0 ? normal.x : axis == 1 ? normal.y : normal.z) = 1.0;
+      const double offset = low[axis] + (high[axis] - low[axis]) * (k + 1.123) / 15;
+      surface.seamTolerances = tolerances;
+      const scallop::PlaneSection section = scallop::planeSection(surface, normal, offset, 1e-4 * size);
+      for (const scallop::SectionCurve& curve : section.curves) {
+        ++curves;
+        EXPECT_TRUE(curve.closed) << "axis " << axis << " offset " << offset << ": a curve of " << curve.points.size()
+                                  << " points stops at " << curve.points.back().point.x << ", "
+                                  << curve.points.back().point.y << ", " << curve.points.back().point.z;
+      }
+      surface.seamTolerances.clear();
+      for (const scallop::SectionCurve& curve : scallop::planeSection(surface, normal, offset, 1e-4 * size).curves)
+        openWithout += !curve.closed;
+    }
+  std::printf("[          ] screw sections: %zu closed loops across its seams; %zu open curves without the seam joins\n",
+              curves, openWithout);
+  EXPECT_GT(curves, 30u);
+  EXPECT_GT(openWithout, 10u);
 }
 
 // --- exact heights ----------------------------------------------------------------------------

@@ -15,7 +15,11 @@
 //         deviate from the true curve by at most about eps (checked at the quarter points
 //         of every edge). Pieces from different cells and patches are joined where their
 //         ends meet (within kJoinTolerance scale), so a closed section comes back as one closed loop and a
-//         section running across patch edges as one curve. `components` counts the connected
+//         section running across patch edges as one curve. On a CAD model's patches, whose
+//         faces meet only to the model's tolerance (surface.hpp's seamTolerances), ends join
+//         within kSeamJoinFactor times the larger of the two patches' tolerances, but never
+//         farther apart than eps (so the joining chord is as close to the curve as the traced
+//         ones): a section crossing a seam between faces is one curve, not two that stop there. `components` counts the connected
 //         pieces (a junction where several branches meet, as at a saddle tangent to the plane,
 //         is one component).
 // Method (why it is robust where the plane is tangent): f(u, v) = N . r(u, v) - d is a
@@ -61,6 +65,14 @@ namespace scallop {
 constexpr int kSectionMaxDepth = 18;
 /// Ends of pieces closer than this times the surface scale are the same point.
 constexpr double kJoinTolerance = 1e-9;
+
+/// Curve ends on two patches of a CAD model are joined within this many times the larger of
+/// the patches' seam tolerances (surface.hpp's seamTolerances): the two faces' edges each
+/// stand within the tolerance t of their shared edge, so a plane crossing the seam at an angle
+/// theta on the surface meets them up to 2 t / sin(theta) apart along it: 16 t joins them
+/// down to theta = 7.2 degrees at the full tolerance (the gaps of real files are mostly far
+/// below their declared tolerance), and the chordal tolerance caps it (section's contract).
+constexpr double kSeamJoinFactor = 16.0;
 
 struct SectionPoint {
   Vec3 point;              ///< r(u, v)

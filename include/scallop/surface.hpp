@@ -109,7 +109,21 @@ struct Surface {
   /// and the Gauss map (through trimmed_patch.hpp's pieces) take only the face's part.
   std::vector<PatchTrim> trims{};
   bool trimmed() const { return !trims.empty(); }
+  /// Empty, or one per patch (>= 0, surface units): how far the patch's edges may stand off
+  /// the neighbouring faces' edges they meet. A CAD model's faces share an edge only to the
+  /// model's tolerance (OCCT's BRep_Tool::Tolerance: 1e-7 mm in most files, up to 4e-4 mm on
+  /// OCCT's sample parts), so a plane section's curve on one face ends that far from its
+  /// continuation on the next. The importer (cad_import.hpp) gives each patch the largest
+  /// tolerance of its face and of that face's edges and vertices; section.hpp joins two curve
+  /// ends of patches p and q within kSeamJoinFactor max(seam p, seam q) of each other. The
+  /// JSON form has none (its patches join exactly).
+  std::vector<double> seamTolerances{};
 };
+
+/// Patch `patch`'s seam tolerance (Surface::seamTolerances; 0 when there are none).
+inline double seamTolerance(const Surface& surface, std::size_t patch) {
+  return surface.seamTolerances.empty() ? 0.0 : surface.seamTolerances[patch];
+}
 
 /// Largest degree accepted in either direction. It bounds the cost of the regularity check,
 /// whose Bernstein form has (4m - 1)(4n - 1) coefficients.
