@@ -81,7 +81,8 @@ VerificationSummary verificationSummary(const SimulationReport& simulated, doubl
                              simulated.gougeTolerance, simulated.maxScallop, simulated.maxScallopAt,
                              simulated.scallopP99, simulated.meanScallop, simulated.uncutArea,
                              simulated.unreachableArea, simulated.maxUnreachableScallop,
-                             simulated.rapidsCutting, simulated.seconds};
+                             simulated.rapidsCutting, simulated.seconds, simulated.clearedGougePoints,
+                             simulated.maxClearedGouge};
 }
 
 // "; rest finishing: ..." when rest passes were added (what the strategies left, what it took).

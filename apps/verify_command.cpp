@@ -159,6 +159,10 @@ int runVerify(const VerifyOptions& options) {
       fmt::print(stderr, "scallop: {}: {:.6g} {}^2 left above H beyond the ball's reach (up to {:.6g} {}): a smaller "
                  "tool's work, not in the scallop figures\n", sources.program, report.unreachableArea, units,
                  report.maxUnreachableScallop, units);
+    if (report.clearedGougePoints > 0)
+      fmt::print(stderr, "scallop: {}: {} points over vertical walls measure up to {:.6g} {} below the wall's top, "
+                 "where the ball that cut them lowest is proven clear of the part: grazed, not gouged\n",
+                 sources.program, report.clearedGougePoints, report.maxClearedGouge, units);
     if (report.rapidsCutting > 0)
       fmt::print(stderr, "scallop: {}: {} rapid moves cut material, the first on line {}\n", sources.program,
                  report.rapidsCutting, report.firstRapidCutLine);

@@ -66,6 +66,30 @@ double lineLowest(Vec3 a, Vec3 b, double radius, double x, double y) {
   return ballLowest({a.x + t * dx, a.y + t * dy, a.z + t * dz}, radius2, x, y);
 }
 
+// The centre at which lineLowest's minimum is attained (the same arithmetic), or nullopt
+// out of reach.
+std::optional<Vec3> lineLowestCentre(Vec3 a, Vec3 b, double radius, double x, double y) {
+  const double radius2 = radius * radius;
+  const double dx = b.x - a.x, dy = b.y - a.y, dz = b.z - a.z;
+  const double h2 = dx * dx + dy * dy;
+  const auto within = [&](Vec3 c) -> std::optional<Vec3> {
+    if ((x - c.x) * (x - c.x) + (y - c.y) * (y - c.y) > radius2) return std::nullopt;
+    return c;
+  };
+  if (h2 == 0.0) return within(dz > 0.0 ? a : b);
+  const double h = std::sqrt(h2);
+  const double wx = x - a.x, wy = y - a.y;
+  const double along = (wx * dx + wy * dy) / h;
+  const double across = (dx * wy - dy * wx) / h;
+  if (std::abs(across) > radius) return std::nullopt;
+  const double k = std::sqrt(radius2 - across * across);
+  const double s = along - dz * k / std::sqrt(h2 + dz * dz);
+  if (s <= 0.0) return within(a);
+  if (s >= h) return within(b);
+  const double t = s / h;
+  return within({a.x + t * dx, a.y + t * dy, a.z + t * dz});
+}
+
 // An arc in its plane's frame (toArcPlane): centre (c1, c2), radius r (the mean of the two
 // ends' distances), angle theta = a0 + dir phi for phi in [0, sweep], normal coordinate
 // n0 + dn phi / sweep.
@@ -232,6 +256,13 @@ class MoveShape {
     if (move_.kind == MoveKind::line) return lineLowest(move_.start, move_.end, radius_, x, y);
     if (!helix_) return flatArcLowest(arc_, radius_, x, y);
     return arc_.plane == ArcPlane::xy ? horizontalHelixLowest(arc_, radius_, x, y) : helixLowest(arc_, radius_, x, y);
+  }
+
+  // The ball centre where lowest(x, y) is attained: lines only (nullopt for arcs and out of
+  // reach).
+  std::optional<Vec3> lowestCentre(double x, double y) const {
+    if (move_.kind != MoveKind::line) return std::nullopt;
+    return lineLowestCentre(move_.start, move_.end, radius_, x, y);
   }
 
   Vec3 lo() const { return lo_; }  // box of the centre's path
@@ -634,7 +665,13 @@ double sweepEvaluations(const std::vector<SweptMove>& moves, double toolRadius, 
 
 std::size_t sweepMoves(const std::vector<SweptMove>& moves, double toolRadius, HeightGrid& stock,
                        std::vector<double>* lowered) {
+  return sweepMoves(moves, toolRadius, stock, lowered, nullptr);
+}
+
+std::size_t sweepMoves(const std::vector<SweptMove>& moves, double toolRadius, HeightGrid& stock,
+                       std::vector<double>* lowered, std::vector<std::uint32_t>* lowestMove) {
   if (lowered) lowered->assign(moves.size(), 0.0);
+  if (lowestMove) lowestMove->assign(stock.z.size(), kNoMove);
   std::size_t visits = 0;
   for (std::size_t m = 0; m < moves.size(); ++m) {
     requireMoveFinite(moves[m], m);
@@ -653,6 +690,7 @@ std::size_t sweepMoves(const std::vector<SweptMove>& moves, double toolRadius, H
         if (low < z) {
           most = std::max(most, z - low);
           z = low;
+          if (lowestMove) (*lowestMove)[j * stock.columns + i] = static_cast<std::uint32_t>(m);
         }
       }
     }
@@ -668,6 +706,21 @@ using ReachTest = std::function<bool(Vec3)>;
 // Called once, only when some point is left above H (its engine is built then, off the path
 // of the simulations that leave none): makes a ReachTest per thread. None: no classification.
 using ReachPreparation = std::function<std::function<ReachTest()>()>;
+
+// Whether a ball centred at c is proven clear of the surface within the gouge tolerance and
+// above it (see the contract's Vertical walls). Prepared as ReachPreparation is, when some
+// point's vertical gouge exceeds the tolerance; none: no point is cleared.
+using ClearanceTest = std::function<bool(Vec3)>;
+using ClearancePreparation = std::function<std::function<ClearanceTest()>()>;
+
+// Runs work(from, to) over [0, count) on up to every core, in blocks of at least 256.
+void onEveryCore(std::size_t count, const std::function<void(std::size_t, std::size_t)>& work) {
+  const std::size_t threads =
+      std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1, std::max<std::size_t>(1, count / 256));
+  std::vector<std::jthread> pool;
+  for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(work, count * t / threads, count * (t + 1) / threads);
+  work(0, count / threads);
+}
 
 // The contract's Reach on a mesh: q's upward normal is that of the triangle that holds q over
 // its grid point (`triangles`, from meshDesign on `grid`), the drop envelope is the exact one
@@ -710,7 +763,8 @@ SimulationReport reportFor(Units units, HeightGrid grid, double highest, const S
 // The sweep and the comparison on a report whose design grid, normals, stock top and
 // tolerances are set.
 void sweepAndCompare(SimulationReport& report, const std::vector<SweptMove>& moves, const SimulationOptions& options,
-                     const ReachPreparation& prepareReach, std::chrono::steady_clock::time_point start);
+                     const ReachPreparation& prepareReach, std::chrono::steady_clock::time_point start,
+                     const ClearancePreparation& prepareClearance = {});
 
 }  // namespace
 
@@ -724,18 +778,37 @@ SimulationReport simulateCut(const Surface& surface, const std::vector<SweptMove
   designHeights(surface, report.design, &report.designNormalZ);
   report.designSeconds = secondsSince(start);
   const double radius = options.toolRadius, height = options.scallopHeight;
-  sweepAndCompare(report, moves, options,
-                  [&]() -> std::function<ReachTest()> {
-                    const auto distance = std::make_shared<const SurfaceDistance>(surface);
-                    return [distance, radius, height]() -> ReachTest {
-                      auto cutter = std::make_shared<DropCutter>(*distance, radius);
-                      return [distance, cutter, radius, height](Vec3 q) {
-                        const ReachWitness witness = reachWitness(*distance, *cutter, q, radius);
-                        return witness.centre && witness.gap > height;
-                      };
-                    };
-                  },
-                  start);
+  // One distance engine for both checks, built when first needed.
+  std::shared_ptr<const SurfaceDistance> engine;
+  const auto sharedDistance = [&] {
+    if (!engine) engine = std::make_shared<const SurfaceDistance>(surface);
+    return engine;
+  };
+  const double slack = report.gougeTolerance;
+  sweepAndCompare(
+      report, moves, options,
+      [&]() -> std::function<ReachTest()> {
+        return [distance = sharedDistance(), radius, height]() -> ReachTest {
+          auto cutter = std::make_shared<DropCutter>(*distance, radius);
+          return [distance, cutter, radius, height](Vec3 q) {
+            const ReachWitness witness = reachWitness(*distance, *cutter, q, radius);
+            return witness.centre && witness.gap > height;
+          };
+        };
+      },
+      start,
+      [&]() -> std::function<ClearanceTest()> {
+        // eps = a quarter of the gouge tolerance (the default 1e-6 scale when that is 0).
+        EnvelopeOptions envelope;
+        envelope.depthTolerance = std::min(slack / 4.0, 0.25 * radius);
+        return [distance = sharedDistance(), radius, slack, envelope]() -> ClearanceTest {
+          auto cutter = std::make_shared<DropCutter>(*distance, radius, envelope);
+          const double eps = envelope.depthTolerance > 0.0 ? envelope.depthTolerance
+                                                           : 1e-6 * std::max(surfaceScale(distance->surface()), 1e-300);
+          const double below = std::max(0.0, slack - 0.5 * eps);
+          return [distance, cutter, below](Vec3 c) { return c.z >= cutter->height(c.x, c.y) - below; };
+        };
+      });
   return report;
 }
 
@@ -779,7 +852,8 @@ SimulationReport simulateCut(Units units, HeightGrid grid, double highest, const
 namespace {
 
 void sweepAndCompare(SimulationReport& report, const std::vector<SweptMove>& moves, const SimulationOptions& options,
-                     const ReachPreparation& prepareReach, std::chrono::steady_clock::time_point start) {
+                     const ReachPreparation& prepareReach, std::chrono::steady_clock::time_point start,
+                     const ClearancePreparation& prepareClearance) {
   const auto sweepStart = std::chrono::steady_clock::now();
   report.stock = report.design;
   const double evaluations = sweepEvaluations(moves, options.toolRadius, report.stock);
@@ -795,7 +869,10 @@ void sweepAndCompare(SimulationReport& report, const std::vector<SweptMove>& mov
     }
   }
   std::vector<double> lowered;
-  report.sweptPointVisits = sweepMoves(moves, options.toolRadius, report.stock, &lowered);
+  std::vector<std::uint32_t> lowestMove;
+  const bool clearing = prepareClearance && options.clearVerticalGouges && moves.size() < kNoMove;
+  report.sweptPointVisits =
+      sweepMoves(moves, options.toolRadius, report.stock, &lowered, clearing ? &lowestMove : nullptr);
   report.sweepSeconds = secondsSince(sweepStart);
   report.moves = moves.size();
   for (std::size_t m = 0; m < moves.size(); ++m) {
@@ -811,6 +888,32 @@ void sweepAndCompare(SimulationReport& report, const std::vector<SweptMove>& mov
   // The comparison.
   const HeightGrid& design = report.design;
   const HeightGrid& stock = report.stock;
+  // Vertical gouges beyond the tolerance cut by a ball proven clear (the contract's Vertical
+  // walls).
+  report.clearedGouge.assign(design.z.size(), 0);
+  if (clearing) {
+    std::vector<std::size_t> deep;
+    for (std::size_t index = 0; index < design.z.size(); ++index)
+      if (design.z[index] != -kInf && design.z[index] - stock.z[index] > report.gougeTolerance &&
+          lowestMove[index] != kNoMove)
+        deep.push_back(index);
+    if (!deep.empty()) {
+      const std::function<ClearanceTest()> clearanceTest = prepareClearance();
+      const std::size_t checks = std::min(deep.size(), options.maxClearanceChecks);
+      report.clearanceChecks = checks;
+      report.clearanceBudgetExhausted = checks < deep.size();
+      onEveryCore(checks, [&](std::size_t from, std::size_t to) {
+        const ClearanceTest clear = clearanceTest();
+        for (std::size_t k = from; k < to; ++k) {
+          const std::size_t index = deep[k];
+          const Vec2 p = design.point(index % design.columns, index / design.columns);
+          const std::optional<Vec3> centre =
+              MoveShape(moves[lowestMove[index]], options.toolRadius).lowestCentre(p.x, p.y);
+          if (centre && clear(*centre)) report.clearedGouge[index] = 1;
+        }
+      });
+    }
+  }
   std::vector<double> scallopAt(design.z.size(), -1.0);  // -1: no surface
   std::vector<std::size_t> uncut;
   for (std::size_t j = 0; j < design.rows; ++j) {
@@ -820,11 +923,16 @@ void sweepAndCompare(SimulationReport& report, const std::vector<SweptMove>& mov
       if (d == -kInf) continue;
       const double s = stock.z[index];
       const Vec2 p = design.point(i, j);
-      if (d - s > report.maxGouge) {
-        report.maxGouge = d - s;
-        report.maxGougeAt = Vec3{p.x, p.y, d};
+      if (report.clearedGouge[index]) {
+        ++report.clearedGougePoints;
+        report.maxClearedGouge = std::max(report.maxClearedGouge, d - s);
+      } else {
+        if (d - s > report.maxGouge) {
+          report.maxGouge = d - s;
+          report.maxGougeAt = Vec3{p.x, p.y, d};
+        }
+        if (d - s > report.gougeTolerance) ++report.gougePoints;
       }
-      if (d - s > report.gougeTolerance) ++report.gougePoints;
       scallopAt[index] = std::max(0.0, s - d) * report.designNormalZ[index];
       if (scallopAt[index] > options.scallopHeight) uncut.push_back(index);
     }
@@ -837,21 +945,14 @@ void sweepAndCompare(SimulationReport& report, const std::vector<SweptMove>& mov
     const std::size_t checks = std::min(uncut.size(), options.maxReachChecks);
     report.reachChecks = checks;
     report.reachBudgetExhausted = checks < uncut.size();
-    const auto classify = [&](std::size_t from, std::size_t to) {
+    onEveryCore(checks, [&](std::size_t from, std::size_t to) {
       const ReachTest beyondReach = reachTest();
       for (std::size_t k = from; k < to; ++k) {
         const std::size_t index = uncut[k];
         const Vec2 p = design.point(index % design.columns, index / design.columns);
         if (beyondReach(Vec3{p.x, p.y, design.z[index]})) report.unreachable[index] = 1;
       }
-    };
-    const std::size_t threads =
-        std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1, std::max<std::size_t>(1, checks / 256));
-    {
-      std::vector<std::jthread> pool;
-      for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(classify, checks * t / threads, checks * (t + 1) / threads);
-      classify(0, checks / threads);
-    }
+    });
     report.reachSeconds = secondsSince(reachStart);
   }
   std::vector<double> scallops;

@@ -187,6 +187,8 @@ std::string pathsToJson(const PathsReport& report, const ToolPath& path) {
     verification["max_gouge_at"] = v.maxGougeAt ? vec(*v.maxGougeAt) : Json(nullptr);
     verification["gouge_area"] = v.gougeArea;
     verification["gouge_tolerance"] = v.gougeTolerance;
+    verification["cleared_gouge_points"] = v.clearedGougePoints;
+    verification["max_cleared_gouge"] = v.maxClearedGouge;
     verification["max_scallop"] = v.maxScallop;
     verification["max_scallop_at"] = v.maxScallopAt ? vec(*v.maxScallopAt) : Json(nullptr);
     verification["scallop_p99"] = v.scallopP99;

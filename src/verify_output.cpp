@@ -97,6 +97,11 @@ std::string verifyToJson(const SimulationReport& r, const VerifySources& sources
   gouge["points"] = r.gougePoints;
   gouge["area"] = r.gougeArea;
   gouge["over_tolerance"] = r.maxGouge > r.gougeTolerance;
+  // Vertical walls the ball only grazed (cut_simulation.hpp): out of the figures above.
+  gouge["cleared_points"] = r.clearedGougePoints;
+  gouge["max_cleared"] = r.maxClearedGouge;
+  gouge["clearance_checks"] = r.clearanceChecks;
+  gouge["clearance_budget_exhausted"] = r.clearanceBudgetExhausted;
   document["gouge"] = gouge;
   Json scallop;
   scallop["max"] = r.maxScallop;
@@ -152,7 +157,8 @@ std::string verifySvg(const SimulationReport& r, const VerifySources& sources) {
           const std::size_t k = j * design.columns + i;
           if (design.z[k] == -std::numeric_limits<double>::infinity()) continue;
           const double difference = stock.z[k] - design.z[k];
-          if (-difference > r.gougeTolerance) worstGouge = std::max(worstGouge, -difference);
+          const bool cleared = k < r.clearedGouge.size() && r.clearedGouge[k];
+          if (-difference > r.gougeTolerance && !cleared) worstGouge = std::max(worstGouge, -difference);
           if (k < r.unreachable.size() && r.unreachable[k]) {
             unreachable = true;
             continue;

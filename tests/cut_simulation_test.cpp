@@ -580,6 +580,100 @@ TEST(DesignHeights, AVerticalWallOnAGridLineEndsWithinItsBudget) {
   EXPECT_EQ(floor, 513u * 513u);
 }
 
+// A step: a top z = 1 over x in [-1, 0], a vertical wall x = 0 down to a floor z = 0 over
+// x in [0, 1], y in [0, 2] throughout. The grid's column through x = 0 lies in the wall.
+Surface stepWithAWall() {
+  BezierPatch top, wall, floor;
+  top.degreeU = top.degreeV = wall.degreeU = wall.degreeV = floor.degreeU = floor.degreeV = 1;
+  top.control = {{-1.0, 0.0, 1.0}, {-1.0, 2.0, 1.0}, {0.0, 0.0, 1.0}, {0.0, 2.0, 1.0}};
+  wall.control = {{0.0, 0.0, 1.0}, {0.0, 2.0, 1.0}, {0.0, 0.0, 0.0}, {0.0, 2.0, 0.0}};
+  floor.control = {{0.0, 0.0, 0.0}, {0.0, 2.0, 0.0}, {1.0, 0.0, 0.0}, {1.0, 2.0, 0.0}};
+  return Surface{Units::inch, {top, wall, floor}};
+}
+
+// Vertical walls (the contract): a ball running along the floor tangent to the wall lowers
+// the wall's grid column to its centre, a vertical "gouge" of the wall's height where the
+// ball cut nothing (its distance to the step, in closed form below, is R); those points are
+// cleared. A pass into the wall, and a ball buried under the top (clear of every face by more
+// than R, but inside the part), are gouges; so is everything with clearVerticalGouges off.
+TEST(CutSimulation, AVerticalWallGrazedByTheBallIsNoGougeButACutIntoItIs) {
+  const Surface step = stepWithAWall();
+  const double radius = 0.25, depth = 0.05;
+  SimulationOptions options;
+  options.toolRadius = radius;
+  options.scallopHeight = 0.01;
+  options.resolution = 1.0 / 64.0;
+  options.margin = 0.0;
+  options.classifyReach = false;
+  // The distance from a centre to the step's faces (each a rectangle), in closed form.
+  const auto stepDistance = [](Vec3 c) {
+    const auto clamp = [](double t, double lo, double hi) { return std::clamp(t, lo, hi); };
+    const double y = clamp(c.y, 0.0, 2.0);
+    const double toTop = scallop::norm(c - Vec3{clamp(c.x, -1.0, 0.0), y, 1.0});
+    const double toWall = scallop::norm(c - Vec3{0.0, y, clamp(c.z, 0.0, 1.0)});
+    const double toFloor = scallop::norm(c - Vec3{clamp(c.x, 0.0, 1.0), y, 0.0});
+    return std::min({toTop, toWall, toFloor});
+  };
+  const SweptMove grazing = lineMove({radius, -0.5, radius}, {radius, 2.5, radius});
+  ASSERT_NEAR(stepDistance(grazing.start + Vec3{0.0, 1.0, 0.0}), radius, 1e-15);
+
+  // The grazing pass alone: the wall's column is cleared, nothing else is deep.
+  const SimulationReport grazed = simulateCut(step, {grazing}, options);
+  std::size_t wallPoints = 0;
+  for (std::size_t j = 0; j < grazed.design.rows; ++j)
+    for (std::size_t i = 0; i < grazed.design.columns; ++i) {
+      const std::size_t k = j * grazed.design.columns + i;
+      const Vec2 p = grazed.design.point(i, j);
+      const bool deep = grazed.design.z[k] - grazed.stock.z[k] > grazed.gougeTolerance;
+      if (p.x == 0.0 && deep) ++wallPoints;
+      EXPECT_EQ(grazed.clearedGouge[k] != 0, deep) << p.x << ", " << p.y;
+      if (deep) {
+        EXPECT_EQ(p.x, 0.0) << p.y;
+      }
+    }
+  EXPECT_EQ(wallPoints, 129u);  // y = 0, 1/64, ..., 2: the design is the wall's top there
+  EXPECT_EQ(grazed.clearedGougePoints, wallPoints);
+  EXPECT_NEAR(grazed.maxClearedGouge, 1.0 - radius, 1e-12);
+  EXPECT_EQ(grazed.gougePoints, 0u);
+  EXPECT_EQ(grazed.maxGouge, 0.0);
+  EXPECT_EQ(grazed.clearanceChecks, wallPoints);
+
+  // Off: the old vertical measure.
+  SimulationOptions unchecked = options;
+  unchecked.clearVerticalGouges = false;
+  const SimulationReport raw = simulateCut(step, {grazing}, unchecked);
+  EXPECT_EQ(raw.gougePoints, wallPoints);
+  EXPECT_EQ(raw.clearedGougePoints, 0u);
+  EXPECT_NEAR(raw.maxGouge, 1.0 - radius, 1e-12);
+
+  // A pass into the wall by `depth` and a ball buried under the top.
+  const SweptMove into = lineMove({radius - depth, 0.5, radius}, {radius - depth, 1.5, radius});
+  const SweptMove buried = lineMove({-0.5, 1.0, 0.3}, {-0.5, 1.2, 0.3});
+  EXPECT_NEAR(stepDistance(into.start), radius - depth, 1e-15);
+  EXPECT_GT(stepDistance(buried.start), radius);  // clear of every face, but inside the part
+  const SimulationReport cut = simulateCut(step, {grazing, into, buried}, options);
+  EXPECT_GT(cut.maxGouge, depth);
+  std::size_t nearInto = 0, nearBuried = 0;
+  for (std::size_t j = 0; j < cut.design.rows; ++j)
+    for (std::size_t i = 0; i < cut.design.columns; ++i) {
+      const std::size_t k = j * cut.design.columns + i;
+      const Vec2 p = cut.design.point(i, j);
+      if (cut.design.z[k] - cut.stock.z[k] <= cut.gougeTolerance || cut.clearedGouge[k]) continue;
+      // Every gouge is under the ball that interferes (within R of its centre line).
+      const bool byInto = std::abs(p.x - (radius - depth)) <= radius && p.y >= 0.5 - radius && p.y <= 1.5 + radius;
+      const bool byBuried = std::abs(p.x + 0.5) <= radius && p.y >= 1.0 - radius && p.y <= 1.2 + radius;
+      EXPECT_TRUE(byInto || byBuried) << p.x << ", " << p.y;
+      nearInto += byInto;
+      nearBuried += byBuried;
+    }
+  EXPECT_GT(nearInto, 100u);
+  EXPECT_GT(nearBuried, 100u);
+  EXPECT_EQ(cut.gougePoints, nearInto + nearBuried);  // the two regions do not overlap
+  // The wall's column away from the pass into it stays cleared.
+  EXPECT_GT(cut.clearedGougePoints, 40u);
+  EXPECT_LT(cut.clearedGougePoints, wallPoints);
+}
+
 TEST(DesignHeights, ThePaperSurfacesAgainstADenseMesh) {
   for (const std::string name : {"paper-1", "paper-2"}) expectDesignMatchesMesh(exampleSurface(name), 0.02, 1e-4, name);
 }

@@ -87,6 +87,22 @@
 //         plan's own doing. Not a proof that no other centre comes nearer (a centre beside c
 //         may): a heuristic classification of what is left, in the report for what it is.
 //         Only points above H are classified, on every core, within maxReachChecks.
+// Vertical walls: the vertical measure is ill-posed over a vertical wall lying along grid
+//         points: the design there is the wall's top, while a ball running beside the wall,
+//         tangent to it, lowers those points to its centre's height, a "gouge" of the wall's
+//         height where nothing of the part was cut. So on a Surface, a point whose vertical
+//         gouge exceeds the tolerance is checked against the ball that cut it lowest: the
+//         line move that set its stock (sweepMoves' lowestMove), its centre c at the
+//         minimiser (the same closed form), and the drop envelope there (envelope.hpp's
+//         DropCutter, depth tolerance eps = gougeTolerance / 4: the lowest height Z found from
+//         which the vertical segment up to the top is proven R - eps / 2 clear of the whole
+//         surface). When c_z >= Z - (gougeTolerance - eps / 2), the ball at c is within
+//         gougeTolerance - eps / 2 below a ball proven clear and in the air above the part, so
+//         it stands at least R - gougeTolerance from the surface and outside it: no material
+//         beyond the tolerance was cut by it, and no other move cut that point lower. Such a
+//         point is "cleared": out of the gouge figures, counted apart (clearedGougePoints).
+//         Arcs, and points past maxClearanceChecks, are not cleared (they count as gouges).
+//         Meshes and designs from elsewhere are not checked (their routes keep a clearance).
 // Meshes: a triangle mesh (mesh.hpp) may stand for the surface: the grid covers its
 //         vertices' xy box; the design at a grid point is the highest of the triangles over
 //         it, exactly (barycentric coordinates in the xy projection, each >= -1e-12 so that a
@@ -189,6 +205,11 @@ struct SimulationOptions {
   /// Budget: reach checks (one closest point and one drop-cutter height each); past it the
   /// remaining points count as reachable (in the scallop figures), and the report says so.
   std::size_t maxReachChecks = 400'000;
+  /// Clear vertical gouges on a Surface by the drop envelope at the centre that cut them
+  /// lowest (see the contract's Vertical walls); false: every one counts.
+  bool clearVerticalGouges = true;
+  /// Budget of those checks (one drop-cutter height each); past it the rest count as gouges.
+  std::size_t maxClearanceChecks = 200'000;
   std::size_t maxPoints = 4'000'000;  ///< grid budget (three doubles per point: 96 MB)
   /// Sweep budget: the (move, grid point) pairs in the moves' boxes grown by R, summed
   /// before the sweep (about a minute of work at the measured 50-60 million per second).
@@ -211,7 +232,15 @@ struct SimulationReport {
   std::size_t surfacePoints = 0;
   double maxGouge = 0.0;               ///< max(0, design - stock)
   std::optional<Vec3> maxGougeAt;      ///< (x, y, design z) when maxGouge > 0
-  std::size_t gougePoints = 0;         ///< design - stock > gougeTolerance
+  std::size_t gougePoints = 0;         ///< design - stock > gougeTolerance, not cleared
+  /// Points whose vertical gouge exceeds the tolerance while the ball that cut them lowest
+  /// is proven clear (see the contract's Vertical walls): out of maxGouge and gougePoints.
+  std::size_t clearedGougePoints = 0;
+  double maxClearedGouge = 0.0;        ///< their largest vertical measure
+  std::size_t clearanceChecks = 0;     ///< points checked
+  bool clearanceBudgetExhausted = false;  ///< some points beyond the tolerance were not checked
+  /// Per grid point: 1 where a vertical gouge was cleared.
+  std::vector<unsigned char> clearedGouge;
   double gougeArea = 0.0;              ///< gougePoints d^2
   double maxScallop = 0.0;
   std::optional<Vec3> maxScallopAt;    ///< (x, y, design z)
@@ -272,6 +301,14 @@ double sweepEvaluations(const std::vector<SweptMove>& moves, double toolRadius, 
 /// `lowered`, if given, receives per move the largest amount it lowered the stock by.
 std::size_t sweepMoves(const std::vector<SweptMove>& moves, double toolRadius, HeightGrid& stock,
                        std::vector<double>* lowered = nullptr);
+
+/// No move lowered the stock there (sweepMoves' lowestMove).
+inline constexpr std::uint32_t kNoMove = 0xffffffffu;
+
+/// The same; `lowestMove`, if given, receives per grid point the first move that cut it
+/// lowest (kNoMove where none lowered it).
+std::size_t sweepMoves(const std::vector<SweptMove>& moves, double toolRadius, HeightGrid& stock,
+                       std::vector<double>* lowered, std::vector<std::uint32_t>* lowestMove);
 
 /// The ball that touches a surface point q from above, as the contract's Reach defines it:
 /// the centre c = q + R n (n the upward unit normal at q's foot point) raised onto the drop

@@ -57,6 +57,10 @@ struct VerificationSummary {
   double maxUnreachableLeft = 0.0;
   std::size_t rapidsCutting = 0;
   double seconds = 0.0;
+  /// Grid points over a vertical wall the ball only grazed (cut_simulation.hpp's Vertical
+  /// walls): out of the gouge figures; their vertical measure at most.
+  std::size_t clearedGougePoints = 0;
+  double maxClearedGouge = 0.0;
 };
 
 /// One round of `scallop plan`'s rest finishing: what the simulated cut left before it, and
