@@ -112,7 +112,13 @@ void runHull(const HullOptions& options) {
   const Chain chain = fromExample ? exampleChain(options.example) : readChain(options.input);
 
   const auto started = std::chrono::steady_clock::now();
-  const ScallopHull result = scallopHull(chain, radius);
+  const ScallopHull result = [&] {
+    try {
+      return scallopHull(chain, radius);
+    } catch (const Error& error) {
+      throw Error(fmt::format("{}: {}", source, error.what()));  // the chain's scale, say
+    }
+  }();
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
 

@@ -1,7 +1,6 @@
 // scallop: command-line front end of the library. main() builds the CLI, dispatches to the
 // subcommand, and is the one place errors are caught: each is printed once, as
-// "scallop: error: <message>", and the exit status is 1 (CLI11's own, non-zero codes for
-// usage errors).
+// "scallop: error: <message>", and the exit status is 1, usage errors included.
 
 #include <cstdio>
 #include <exception>
@@ -43,7 +42,13 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
-    return app.exit(error);
+    // --help and --version are "errors" with exit code 0: CLI11 prints them. Every other one
+    // is a usage error: one line and exit status 1, as any other error (CLI11's own would be
+    // 105-109 and a second line).
+    if (error.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(error);
+    std::string help = "scallop --help";
+    for (const CLI::App* command : app.get_subcommands()) help = fmt::format("scallop {} --help", command->get_name());
+    return reportError(fmt::format("{} (see {})", error.what(), help).c_str());
   } catch (const std::exception& error) {
     // scallop::Error (bad input, unwritable output) and anything else, e.g. std::bad_alloc.
     return reportError(error.what());

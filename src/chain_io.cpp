@@ -1,5 +1,6 @@
 #include "examples.hpp"
 #include "input_file.hpp"
+#include "json_input.hpp"
 #include "text_input.hpp"
 #include "scallop/chain_io.hpp"
 
@@ -201,15 +202,6 @@ Chain parseTextChain(std::string_view content, const std::string& source) {
 // JSON format
 // ---------------------------------------------------------------------------------------
 
-// nlohmann's messages start with "[json.exception.parse_error.101] "; the rest (line,
-// column, what was expected) is what a user needs.
-std::string withoutExceptionId(const std::string& message) {
-  if (!message.empty() && message.front() == '[') {
-    const std::size_t close = message.find("] ");
-    if (close != std::string::npos) return message.substr(close + 2);
-  }
-  return message;
-}
 
 [[noreturn]] void throwAtPoint(const std::string& source, std::size_t index, std::string_view what,
                                const nlohmann::json& value) {
@@ -231,14 +223,7 @@ Point2 jsonPoint(const nlohmann::json& value, std::size_t index, const std::stri
 }
 
 Chain parseJsonChain(std::string_view content, const std::string& source) {
-  nlohmann::json document;
-  try {
-    document = nlohmann::json::parse(content.begin(), content.end());
-  } catch (const nlohmann::json::exception& error) {
-    // parse_error (syntax, with line and column), or out_of_range for a number literal
-    // beyond the range of a double.
-    throw Error(fmt::format("{}: malformed JSON: {}", source, withoutExceptionId(error.what())));
-  }
+  nlohmann::json document = detail::parseJsonDocument(content, source);
   if (!document.is_object() || !document.contains("points") || !document["points"].is_array()) {
     throw Error(fmt::format("{}: expected a JSON object {{\"points\": [[x, z], ...]}}", source));
   }

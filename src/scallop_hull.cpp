@@ -16,6 +16,7 @@ namespace scallop {
 namespace {
 
 constexpr double kRelativeTolerance = 1e-12;  // tau = kRelativeTolerance * scale (header)
+constexpr double kMaxToleranceOfRadius = 1e-3;  // tau / r above this is refused (header)
 
 double arcTop(const Point2& centre, double r, double x) {
   // Upper semicircle z = c_z + sqrt(r^2 - d^2), written as (r - |d|)(r + |d|) so the value
@@ -813,6 +814,13 @@ ScallopHull scallopHull(std::span<const Point2> chain, double radius) {
   const double r = radius;
   const double scale = std::max(r, coordinateScale(chain));
   const double tau = kRelativeTolerance * scale;
+  // Far from the origin the tolerance outgrows the ball: the hull would be answered within
+  // more than r / 1000 (at 1e15 with r = 1, within 1000: an empty path). Refused instead.
+  if (tau > kMaxToleranceOfRadius * r)
+    throw Error(fmt::format("the radius {} is below {} of the chain's largest |coordinate| {}: the tolerance "
+                            "{} x {} would exceed {} of the radius; give the chain's coordinates from a nearby origin",
+                            r, kRelativeTolerance / kMaxToleranceOfRadius, scale, kRelativeTolerance, scale,
+                            kMaxToleranceOfRadius));
   // Edges steeper than this run are vertical (a tenth of the tolerance; see makeCapsule).
   const double verticalRun = 0.1 * tau;
   // Distances are known to about this much (a few ulps of the coordinates and of r).

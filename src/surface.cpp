@@ -1,5 +1,6 @@
 #include "examples.hpp"
 #include "teapot.hpp"
+#include "json_input.hpp"
 #include "text_input.hpp"
 #include "scallop/surface.hpp"
 
@@ -39,15 +40,6 @@ using Json = nlohmann::json;
 std::string quoted(const Json& value) { return detail::clipped(value.dump()); }
 
 
-// nlohmann's messages start with "[json.exception.parse_error.101] "; the rest (line,
-// column, what was expected) is what a user needs.
-std::string withoutExceptionId(const std::string& message) {
-  if (!message.empty() && message.front() == '[') {
-    const std::size_t close = message.find("] ");
-    if (close != std::string::npos) return message.substr(close + 2);
-  }
-  return message;
-}
 
 // "patches[1]", "patches[1].degree", "patches[1].control_points[2][0]".
 std::string patchPath(std::size_t patch) { return fmt::format("patches[{}]", patch); }
@@ -932,14 +924,7 @@ Surface parseSurface(std::string_view json, const std::string& sourceName, Surfa
   if (json.substr(0, kByteOrderMark.size()) == kByteOrderMark) {
     json.remove_prefix(kByteOrderMark.size());
   }
-  Json document;
-  try {
-    document = Json::parse(json.begin(), json.end());
-  } catch (const Json::exception& error) {
-    // parse_error (syntax, with line and column), or out_of_range for a number literal
-    // beyond the range of a double.
-    throw Error(fmt::format("{}: malformed JSON: {}", source, withoutExceptionId(error.what())));
-  }
+  const Json document = detail::parseJsonDocument(json, source);
   Surface surface = parseDocument(document, source);
   if (check == SurfaceCheck::full) validateSurface(surface, source);
   return surface;

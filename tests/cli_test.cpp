@@ -62,6 +62,8 @@ const std::vector<BadRun>& badRuns() {
        "{\"points\": [[0, 0], [1, \"2\"]]}",
        "in.json -r 1",
        {"in.json", "points[1]"}},
+      {"r below the coordinates' tolerance", "in.txt", "0 1e15\n1 1e15\n", "in.txt -r 1",
+       {"in.txt", "radius 1 is below"}},
       {"r zero", "in.txt", "0 0\n1 1\n", "in.txt -r 0", {"radius", "'0'"}},
       {"r negative", "in.txt", "0 0\n1 1\n", "in.txt --radius=-2.5", {"radius", "'-2.5'"}},
       {"r NaN", "in.txt", "0 0\n1 1\n", "in.txt -r nan", {"radius", "'nan'"}},
@@ -85,17 +87,50 @@ TEST_F(Cli, BadInputFailsWithMessageAndWritesNothing) {
   }
 }
 
+// A document nested 80,000 deep (issue 15's audit: the message quoting the value recursed
+// once a level and overflowed the stack) is refused while it is parsed, by every command that
+// reads JSON: one line, exit 1, nothing written.
+TEST_F(Cli, DeeplyNestedJsonIsRefusedByEveryCommand) {
+  const std::size_t depth = 80000;
+  const std::string nested = std::string(depth, '[') + std::string(depth, ']');
+  write("chain.json", "{\"points\": [[0, 0], " + nested + "]}");
+  expectCleanFailure(run("hull chain.json -r 1"), {"chain.json", "malformed JSON", "nested more than 64"}, "chain.json");
+  std::filesystem::remove(workDir_ / "chain.json");
+  write("surface.json", "{\"units\": \"in\", \"patches\": [" + nested + "]}");
+  for (const std::string command :
+       {"orient surface.json", "paths surface.json --tool-radius 0.25 --scallop-height 0.01 --json out.json", "plan surface.json --out out"})
+    expectCleanFailure(run(command), {"surface.json", "malformed JSON", "nested more than 64"}, "surface.json");
+  write("p.ngc", "G20\nG0 X0 Y0 Z1\nM2\n");
+  const scallop::test::RunResult verify = run("verify surface.json p.ngc --radius 0.25");
+  EXPECT_EQ(verify.exitCode, 1);
+  EXPECT_EQ(verify.err.rfind("scallop: error: surface.json: malformed JSON: arrays or objects nested more than 64", 0), 0u)
+      << verify.err;
+  EXPECT_EQ(std::count(verify.err.begin(), verify.err.end(), '\n'), 1) << verify.err;
+}
+
+// Every usage error, the option parser's (a missing or unknown option, a bad choice, too
+// many files: CLI11's exit codes 105-109 and a second line before) and scallop's own, is one
+// line "scallop: error: ..." and exit status 1, as the README says.
 TEST_F(Cli, UsageErrorsFailWithoutOutput) {
   write("in.txt", "0 0\n1 1\n");
   for (const char* arguments :
        {"", "hull --json out.json -r 1", "hull in.txt --example figure2 -r 1 --json out.json",
         "hull --example nope -r 1 --json out.json", "hull in.txt --json out.json",
-        "hull in.txt -r 1 --bogus", "hull in.txt -r 1 --json - --svg -"}) {
+        "hull in.txt -r 1 --bogus", "hull in.txt -r 1 --json - --svg -", "bogus", "hull in.txt -r",
+        "verify in.txt p.ngc --tool-radius 2", "orient in.txt --method nope", "plan --out"}) {
     SCOPED_TRACE(arguments);
     const RunResult result = run(arguments);
-    EXPECT_NE(result.exitCode, 0);
-    EXPECT_FALSE(result.err.empty());
+    EXPECT_EQ(result.exitCode, 1);
+    EXPECT_EQ(result.err.rfind("scallop: error: ", 0), 0u) << result.err;
+    EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
     EXPECT_EQ(listing(), std::vector<std::string>{"in.txt"});
+  }
+  // Help and the version are not errors.
+  for (const char* arguments : {"--help", "hull --help", "--version"}) {
+    SCOPED_TRACE(arguments);
+    const RunResult result = run(arguments);
+    EXPECT_EQ(result.exitCode, 0);
+    EXPECT_FALSE(result.out.empty());
   }
 }
 

@@ -1683,7 +1683,7 @@ constexpr int kTransformCases = 1200;
 
 TEST(ScallopHullTransforms, TranslationTranslatesResults) {
   std::mt19937_64 rng(42);
-  int compared = 0, failures = 0;
+  int compared = 0, failures = 0, refused = 0;
   for (int i = 0; i < kTransformCases; ++i) {
     const Case c = randomCase(kGenericShapes[pick(rng, kGenericShapes.size())], i, rng);
     const double w = std::max(c.chain.back().x - c.chain.front().x, c.radius);
@@ -1693,8 +1693,15 @@ TEST(ScallopHullTransforms, TranslationTranslatesResults) {
     Case t{c.name + "_translated", {}, c.radius};
     for (const Point2& p : c.chain) t.chain.push_back({p.x + dx, p.z + dz});
     const ScallopHull a = scallop::scallopHull(c.chain, c.radius);
-    const ScallopHull b = scallop::scallopHull(t.chain, t.radius);
     const double tauT = toleranceFor(t.chain, t.radius);
+    // A small ball moved far away: the tolerance would exceed r / 1000 (the contract): refused.
+    if (1e-12 * std::max(t.radius, coordinateScaleOf(t.chain)) > 1e-3 * t.radius) {
+      EXPECT_THROW(scallop::scallopHull(t.chain, t.radius), scallop::Error) << corpusEntry(c);
+      EXPECT_TRUE(far) << corpusEntry(c);  // only a ball far from the origin
+      ++refused;
+      continue;
+    }
+    const ScallopHull b = scallop::scallopHull(t.chain, t.radius);
     Violations v;
     checkMappedBand(c, b, tauT, std::max(t.radius, coordinateScaleOf(t.chain)), 1.0,
                     [&](Point2 p) { return Point2{p.x - dx, p.z - dz}; }, v);
@@ -1708,7 +1715,8 @@ TEST(ScallopHullTransforms, TranslationTranslatesResults) {
       ADD_FAILURE() << "translation by " << fmt(Point2{dx, dz}) << ":\n" << v.str() << corpusEntry(c);
   }
   EXPECT_EQ(failures, 0);
-  EXPECT_EQ(compared, kTransformCases);
+  EXPECT_EQ(compared + refused, kTransformCases);
+  EXPECT_LT(refused, kTransformCases / 10);  // 61 of 1,200: the smallest balls moved 1e6 away
 }
 
 TEST(ScallopHullTransforms, UniformScalingScalesResults) {
@@ -2019,6 +2027,27 @@ TEST(ScallopHullStats, AdversarialChainsPassAllChecks) {
 // ---------------------------------------------------------------------------------------
 // 7. Errors
 // ---------------------------------------------------------------------------------------
+
+// Issue 15's audit: a chain at z = 1e15 with r = 1 gave an empty tool path (the tolerance,
+// 1e-12 of the coordinates, exceeded the radius). Refused, naming both; 5e8 r still works.
+TEST(ScallopHullErrors, ARadiusBelowTheToleranceOfTheCoordinatesIsRefused) {
+  for (const double z : {1e15, -1e13, 2e9}) {
+    SCOPED_TRACE(z);
+    const Chain chain{{0, z}, {1, z}};
+    try {
+      scallop::scallopHull(chain, 1.0);
+      ADD_FAILURE() << "no exception";
+    } catch (const scallop::Error& e) {
+      EXPECT_NE(std::string(e.what()).find("radius 1 is below"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("largest |coordinate|"), std::string::npos) << e.what();
+    }
+  }
+  const Chain far{{0, 5e8}, {1, 5e8}, {2, 5e8 + 0.5}};
+  const scallop::ScallopHull hull = scallop::scallopHull(far, 1.0);
+  ASSERT_FALSE(hull.toolpath.empty());
+  // At x = 1 the centre rides the slope's offset line: 5e8 + sqrt(1.25), within tau = 5e-4.
+  EXPECT_NEAR(scallop::pathHeightAt(hull.toolpath, 1.0), 5e8 + std::sqrt(1.25), 5e-4);
+}
 
 TEST(ScallopHullErrors, BadRadiusNamesTheValue) {
   const Chain chain{{0, 0}, {1, 1}, {2, 0}};

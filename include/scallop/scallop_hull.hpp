@@ -26,7 +26,9 @@
 //         is at distance within tau of the exact envelope (its distance to the chain lies in
 //         [r - tau, r + tau]); contact points lie within tau of the chain. Pieces shorter
 //         than tau are merged into their neighbours (so lids that coincide within tau are
-//         one lid, as the paper's COINCIDE step).
+//         one lid, as the paper's COINCIDE step). A chain so far from the origin that tau
+//         exceeds r / 1000 (largest |coordinate| > 1e9 r) is refused with an error: the hull
+//         would mean nothing at that resolution.
 //
 // Method (why it is linear)
 // -------------------------
