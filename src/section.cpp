@@ -387,7 +387,7 @@ void clipPiece(const Piece& piece, const BezierPatch& patch, const PatchTrim& tr
   if (current.size() >= 2) out.push_back(std::move(current));
 }
 
-// Two ends are one node when they are within joinTolerance, or, on patches of a CAD model,
+// Two ends are one node when they are within joinTolerance, or, on two patches of a CAD model,
 // within kSeamJoinFactor times the larger of their patches' seam tolerances (surface.hpp) but
 // no farther than the chordal tolerance: the joining chord then stands no farther from the
 // true curve than the traced chords do.
@@ -402,10 +402,12 @@ void joinPieces(std::vector<Piece> pieces, double joinTolerance, double chordalT
     const Piece& p = pieces[e / 2];
     return (e % 2 == 0 ? p.front() : p.back()).point;
   };
-  auto endSeam = [&](std::size_t e) {
+  auto endPatch = [&](std::size_t e) {
     const Piece& p = pieces[e / 2];
-    return std::min(chordalTolerance,
-                    kSeamJoinFactor * seamTolerance(surface, (e % 2 == 0 ? p.front() : p.back()).patch));
+    return (e % 2 == 0 ? p.front() : p.back()).patch;
+  };
+  auto endSeam = [&](std::size_t e) {
+    return std::min(chordalTolerance, kSeamJoinFactor * seamTolerance(surface, endPatch(e)));
   };
   double widest = 0.0;
   for (std::size_t e = 0; e < 2 * count; ++e) widest = std::max(widest, endSeam(e));
@@ -415,7 +417,10 @@ void joinPieces(std::vector<Piece> pieces, double joinTolerance, double chordalT
   for (std::size_t i = 0; i < order.size(); ++i) {
     for (std::size_t j = i + 1; j < order.size(); ++j) {
       if (endPoint(order[j]).x - endPoint(order[i]).x > std::max(joinTolerance, widest)) break;
-      const double reach = std::max({joinTolerance, endSeam(order[i]), endSeam(order[j])});
+      // A seam lies between two patches: ends on one patch meet exactly or not at all.
+      const double reach = endPatch(order[i]) == endPatch(order[j])
+                               ? joinTolerance
+                               : std::max({joinTolerance, endSeam(order[i]), endSeam(order[j])});
       if (norm(endPoint(order[j]) - endPoint(order[i])) <= reach) ends.unite(order[i], order[j]);
     }
   }

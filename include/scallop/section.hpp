@@ -16,8 +16,8 @@
 //         of every edge). Pieces from different cells and patches are joined where their
 //         ends meet (within kJoinTolerance scale), so a closed section comes back as one closed loop and a
 //         section running across patch edges as one curve. On a CAD model's patches, whose
-//         faces meet only to the model's tolerance (surface.hpp's seamTolerances), ends join
-//         within kSeamJoinFactor times the larger of the two patches' tolerances, but never
+//         faces meet only to the model's tolerance (surface.hpp's seamTolerances), ends of two
+//         patches join within kSeamJoinFactor times the larger of their tolerances, but never
 //         farther apart than eps (so the joining chord is as close to the curve as the traced
 //         ones): a section crossing a seam between faces is one curve, not two that stop there. `components` counts the connected
 //         pieces (a junction where several branches meet, as at a saddle tangent to the plane,
