@@ -47,47 +47,36 @@ double ballLowest(Vec3 c, double radius2, double x, double y) {
 // distance, and -sqrt(R^2 - rho^2) convex and increasing in rho >= 0). With p at horizontal
 // coordinates (s_p along the line's xy direction from a, e across it), rho^2 = e^2 +
 // (s - s_p)^2 and g'(s) = 0 gives s - s_p = -dz k / L (k = sqrt(R^2 - e^2), L the 3D length,
-// dz the rise): the stationary point, clamped to the segment, is the minimiser.
-double lineLowest(Vec3 a, Vec3 b, double radius, double x, double y) {
-  const double radius2 = radius * radius;
+// dz the rise): the stationary point, clamped to the segment, is the minimiser. Its centre,
+// or nullopt when p lies more than R across the line (out of reach of every position).
+std::optional<Vec3> lineMinimiser(Vec3 a, Vec3 b, double radius, double x, double y) {
   const double dx = b.x - a.x, dy = b.y - a.y, dz = b.z - a.z;
   const double h2 = dx * dx + dy * dy;
-  if (h2 == 0.0) return ballLowest(dz > 0.0 ? a : b, radius2, x, y);  // vertical or a point
-  const double h = std::sqrt(h2);
-  const double wx = x - a.x, wy = y - a.y;
-  const double along = (wx * dx + wy * dy) / h;
-  const double across = (dx * wy - dy * wx) / h;
-  if (std::abs(across) > radius) return kInf;
-  const double k = std::sqrt(radius2 - across * across);
-  const double s = along - dz * k / std::sqrt(h2 + dz * dz);
-  if (s <= 0.0) return ballLowest(a, radius2, x, y);
-  if (s >= h) return ballLowest(b, radius2, x, y);
-  const double t = s / h;
-  return ballLowest({a.x + t * dx, a.y + t * dy, a.z + t * dz}, radius2, x, y);
-}
-
-// The centre at which lineLowest's minimum is attained (the same arithmetic), or nullopt
-// out of reach.
-std::optional<Vec3> lineLowestCentre(Vec3 a, Vec3 b, double radius, double x, double y) {
-  const double radius2 = radius * radius;
-  const double dx = b.x - a.x, dy = b.y - a.y, dz = b.z - a.z;
-  const double h2 = dx * dx + dy * dy;
-  const auto within = [&](Vec3 c) -> std::optional<Vec3> {
-    if ((x - c.x) * (x - c.x) + (y - c.y) * (y - c.y) > radius2) return std::nullopt;
-    return c;
-  };
-  if (h2 == 0.0) return within(dz > 0.0 ? a : b);
+  if (h2 == 0.0) return dz > 0.0 ? a : b;  // vertical or a point: its lowest end
   const double h = std::sqrt(h2);
   const double wx = x - a.x, wy = y - a.y;
   const double along = (wx * dx + wy * dy) / h;
   const double across = (dx * wy - dy * wx) / h;
   if (std::abs(across) > radius) return std::nullopt;
-  const double k = std::sqrt(radius2 - across * across);
+  const double k = std::sqrt(radius * radius - across * across);
   const double s = along - dz * k / std::sqrt(h2 + dz * dz);
-  if (s <= 0.0) return within(a);
-  if (s >= h) return within(b);
+  if (s <= 0.0) return a;
+  if (s >= h) return b;
   const double t = s / h;
-  return within({a.x + t * dx, a.y + t * dy, a.z + t * dz});
+  return Vec3{a.x + t * dx, a.y + t * dy, a.z + t * dz};
+}
+
+// The lowest point of the ball swept along the line above (x, y): +inf out of reach.
+double lineLowest(Vec3 a, Vec3 b, double radius, double x, double y) {
+  const std::optional<Vec3> centre = lineMinimiser(a, b, radius, x, y);
+  return centre ? ballLowest(*centre, radius * radius, x, y) : kInf;
+}
+
+// The centre at which lineLowest's minimum is attained, or nullopt out of reach.
+std::optional<Vec3> lineLowestCentre(Vec3 a, Vec3 b, double radius, double x, double y) {
+  const std::optional<Vec3> centre = lineMinimiser(a, b, radius, x, y);
+  if (!centre || ballLowest(*centre, radius * radius, x, y) == kInf) return std::nullopt;
+  return centre;
 }
 
 // An arc in its plane's frame (toArcPlane): centre (c1, c2), radius r (the mean of the two

@@ -59,6 +59,17 @@ std::vector<TrimArc> circleArcs(double cu, double cv, double radius, bool clockw
   return arcs;
 }
 
+// The rectangle [u0, u1] x [v0, v1] as four straight arcs anticlockwise, then a clockwise
+// circular hole in it.
+std::vector<TrimArc> squareWithHole(double u0, double v0, double u1, double v1, double cu, double cv, double radius) {
+  const double corners[4][2] = {{u0, v0}, {u1, v0}, {u1, v1}, {u0, v1}};
+  std::vector<TrimArc> arcs;
+  for (int i = 0; i < 4; ++i)
+    arcs.push_back(TrimArc{{corners[i][0], corners[i][1], 1.0}, {corners[(i + 1) % 4][0], corners[(i + 1) % 4][1], 1.0}});
+  for (const TrimArc& arc : circleArcs(cu, cv, radius, true)) arcs.push_back(arc);
+  return arcs;
+}
+
 // The face: in the patch's own parameters (s, t), the disk |(s, t) - (0.5, 0.45)| <= 0.3
 // (`hole` false) or the square minus that disk (`hole` true). The face's parameters are
 // u = 10 - 4 s (reversed) and v = 2 + 4 t, where the circle is centred at (8, 3.8) with
@@ -73,16 +84,8 @@ struct TrimmedPaper {
     auto face = std::make_shared<FaceTrim>();
     // The circle in face parameters: s = (10 - u) / 4, t = (v - 2) / 4.
     const double cu = 10.0 - 4.0 * kCentreS, cv = 2.0 + 4.0 * kCentreT, r = 4.0 * kRadius;
-    if (hole) {
-      // The square's boundary (u from 10 down to 6, v from 2 to 6), then the hole.
-      const double corners[4][2] = {{6, 2}, {10, 2}, {10, 6}, {6, 6}};
-      for (int i = 0; i < 4; ++i)
-        face->arcs.push_back(
-            TrimArc{{corners[i][0], corners[i][1], 1.0}, {corners[(i + 1) % 4][0], corners[(i + 1) % 4][1], 1.0}});
-      for (const TrimArc& arc : circleArcs(cu, cv, r, true)) face->arcs.push_back(arc);
-    } else {
-      face->arcs = circleArcs(cu, cv, r, false);
-    }
+    // The square's boundary (u from 10 down to 6, v from 2 to 6), then the hole; or the disk.
+    face->arcs = hole ? squareWithHole(6, 2, 10, 6, cu, cv, r) : circleArcs(cu, cv, r, false);
     PatchTrim trim;
     trim.face = face;
     trim.u = scallop::AxisMap::affine(10.0, 6.0), trim.v = scallop::AxisMap::affine(2.0, 6.0);
@@ -139,15 +142,8 @@ struct TrimmedArch {
     surface.units = scallop::Units::millimetre;
     surface.patches = {patch};
     auto face = std::make_shared<FaceTrim>();
-    if (hole) {
-      const double corners[4][2] = {{kStart, 0}, {kEnd, 0}, {kEnd, 3}, {kStart, 3}};
-      for (int i = 0; i < 4; ++i)
-        face->arcs.push_back(
-            TrimArc{{corners[i][0], corners[i][1], 1.0}, {corners[(i + 1) % 4][0], corners[(i + 1) % 4][1], 1.0}});
-      for (const TrimArc& arc : circleArcs(kCentreU, kCentreV, kRadius, true)) face->arcs.push_back(arc);
-    } else {
-      face->arcs = circleArcs(kCentreU, kCentreV, kRadius, false);
-    }
+    face->arcs = hole ? squareWithHole(kStart, 0, kEnd, 3, kCentreU, kCentreV, kRadius)
+                      : circleArcs(kCentreU, kCentreV, kRadius, false);
     PatchTrim trim;
     trim.face = face;
     // The map through the angles of the patch's points at s = 0, 1/2, 1, read off with atan2
