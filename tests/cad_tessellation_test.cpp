@@ -842,11 +842,13 @@ TEST_F(CadTessellationCli, PlanCutsATrimmedBSplineFaceExactlyOnTheFaceAlone) {
   const Surface paper = exampleFile("paper-1");
   const TopoDS_Shape face = paperDiskFace(paper);
   writeStep(face, workDir_ / "disk.step", "INCH");
-  const double radius = 0.25, height = 0.002;
+  // A ball of 1/8 in and H 0.004 in (0.25 and 0.002 took twice the run time: the
+  // trimmed face's distance queries per pass end and per checked point dominate).
+  const double radius = 0.125, height = 0.004;
   for (const std::string strategy : {"contour", "raster"}) {
     SCOPED_TRACE(strategy);
     const scallop::test::RunResult plan = run("plan disk.step --exact-trims --strategy " + strategy +
-                                              " --tool-radius 0.25 --scallop-height 0.002 --out out");
+                                              " --tool-radius 0.125 --scallop-height 0.004 --out out");
     ASSERT_EQ(plan.exitCode, 0) << plan.err;
     EXPECT_EQ(plan.err.find("cannot be machined exactly"), std::string::npos) << plan.err;
     const auto report = nlohmann::json::parse(scallop::test::readFile(workDir_ / "out" / "report.json"));
@@ -925,7 +927,7 @@ TEST_F(CadTessellationCli, PlanAndVerifyOpenCascadesSampleStepAndIgesParts) {
     std::string radius;
     std::string height;
   };
-  for (const Sample& sample : {Sample{"step/screw.step", "3", "0.05"}, Sample{"iges/bearing.iges", "0.004", "0.0008"}}) {
+  for (const Sample& sample : {Sample{"step/screw.step", "3", "0.05"}, Sample{"iges/bearing.iges", "0.004", "0.0016"}}) {
     const std::string path = kOcctSamples + "/" + sample.file;
     if (!fs::exists(path)) GTEST_FAIL() << path << " is missing: Debian's occt-misc package installs it";
     const scallop::test::RunResult plan = run("plan " + path + " --tool-radius " + sample.radius +
@@ -936,7 +938,7 @@ TEST_F(CadTessellationCli, PlanAndVerifyOpenCascadesSampleStepAndIgesParts) {
     EXPECT_LE(report["verification"]["max_gouge"].get<double>(), 0.0025) << sample.file;
     if (sample.file == "iges/bearing.iges") {
       // Its model's tolerance makes the clearance exceed H: no rest pass could help, none is made.
-      EXPECT_GE(report["tessellation"]["clearance"].get<double>(), 0.0008);
+      EXPECT_GE(report["tessellation"]["clearance"].get<double>(), 0.0016);
       EXPECT_TRUE(report["rest_finishing"].is_null());
     }
     if (sample.file == "step/screw.step") {
