@@ -125,9 +125,8 @@ void runHull(const HullOptions& options) {
   std::vector<OutputFile> outputs;
   const std::string jsonPath = jsonDestination(options);
   if (!jsonPath.empty()) {
-    outputs.push_back({jsonPath, sampled ? hullToJson(result, chain.size(), seconds,
-                                                      samplePath(result.toolpath, tolerance))
-                                         : hullToJson(result, chain.size(), seconds)});
+    outputs.push_back({jsonPath, sampled ? hullToJson(result, chain.size(), samplePath(result.toolpath, tolerance))
+                                         : hullToJson(result, chain.size())});
   }
   if (!options.svgPath.empty()) outputs.push_back({options.svgPath, hullToSvg(chain, result)});
   writeFilesAtomically(outputs);

@@ -10,6 +10,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "scallop/parallel.hpp"
 
 #ifndef SCALLOP_VERSION
 #error "SCALLOP_VERSION is set by apps/CMakeLists.txt from project(VERSION ...)"
@@ -33,6 +34,13 @@ int main(int argc, char** argv) {
       "scallop"};
   app.set_version_flag("--version", std::string("scallop ") + SCALLOP_VERSION);
   app.require_subcommand(1);
+  // Before or after the command's name (fallthrough): every command's parallel parts use it,
+  // and every output is the same for every count (parallel.hpp).
+  app.add_option_function<std::size_t>(
+         "--threads", [](std::size_t threads) { scallop::setThreadCount(threads); },
+         "Threads for the parallel parts (0: every core, the default); the output is the same for any count")
+      ->check(CLI::Range(std::size_t{0}, std::size_t{1024}));
+  app.fallthrough();
   scallop::cli::addHullCommand(app);
   scallop::cli::addOrientCommand(app);
   scallop::cli::addPathsCommand(app);

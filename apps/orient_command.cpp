@@ -91,7 +91,7 @@ void runOrientMesh(const OrientOptions& options) {
   const MeshSlicing result = optimalMeshSlicing(mesh.mesh);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const std::string jsonPath = jsonDestination(options);
-  writeOutputs({{jsonPath, meshOrientationToJson(result, mesh, path, seconds)}}, "");
+  writeOutputs({{jsonPath, meshOrientationToJson(result, mesh, path)}}, "");
   if (jsonPath != kStandardStream) {
     fmt::print(stderr,
                "scallop: {}: {} triangles ({} STL{}), {} distinct normals: N* = ({:.6f}, {:.6f}, {:.6f}), alpha* = "
@@ -132,7 +132,7 @@ void runOrientTessellated(const OrientOptions& options, const CadPart& part, con
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const TessellationFacts facts{part.units(), part.faces(), tessellation.deflection, mesh.deviation,
                                 mesh.normalDeviationRad, mesh.sampledNormals.size()};
-  writeOutputs({{jsonPath, tessellationOrientationToJson(result, facts, source, seconds)}}, "");
+  writeOutputs({{jsonPath, tessellationOrientationToJson(result, facts, source)}}, "");
   if (talk) {
     fmt::print(stderr,
                "scallop: {}: {} exact normals sampled on its {} faces (at the nodes and inside the triangles of its "

@@ -37,6 +37,7 @@
 
 #include "cad_file.hpp"
 #include "scallop/error.hpp"
+#include "scallop/parallel.hpp"
 
 namespace scallop {
 namespace {
@@ -300,9 +301,7 @@ void CadPart::designHeights(HeightGrid& grid, std::vector<double>* normalZ, cons
                             impl_->path, grid.columns, grid.rows, grid.spacing, columns * rows, options.maxRays));
   const double clearance = 1.0 + (high.z - low.z);
   const double top = high.z + clearance, length = (high.z - low.z) + 2.0 * clearance;
-  const unsigned threads = std::max(
-      1u, std::min(options.threads == 0 ? std::thread::hardware_concurrency() : options.threads,
-                   static_cast<unsigned>(std::min<std::size_t>(rows, 64))));
+  const std::size_t threads = std::clamp<std::size_t>(threadCount(options.threads), 1, std::min<std::size_t>(rows, 64));
   // Rows are dealt out one at a time; each thread owns its intersector and writes only its
   // rows' points, so the result is the same for any number of threads.
   std::atomic<std::size_t> nextRow{j0};
@@ -349,7 +348,7 @@ void CadPart::designHeights(HeightGrid& grid, std::vector<double>* normalZ, cons
     }
   };
   std::vector<std::thread> pool;
-  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(work);
+  for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(work);
   work();
   for (std::thread& thread : pool) thread.join();
   if (failure) {

@@ -24,6 +24,7 @@
 #include "scallop/gouge.hpp"
 #include "scallop/mesh.hpp"
 #include "scallop/mesh_drop.hpp"
+#include "scallop/parallel.hpp"
 #include "scallop/surface.hpp"
 
 namespace scallop {
@@ -705,7 +706,7 @@ using ClearancePreparation = std::function<std::function<ClearanceTest()>()>;
 // Runs work(from, to) over [0, count) on up to every core, in blocks of at least 256.
 void onEveryCore(std::size_t count, const std::function<void(std::size_t, std::size_t)>& work) {
   const std::size_t threads =
-      std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1, std::max<std::size_t>(1, count / 256));
+      std::clamp<std::size_t>(threadCount(), 1, std::max<std::size_t>(1, count / 256));
   std::vector<std::jthread> pool;
   for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(work, count * t / threads, count * (t + 1) / threads);
   work(0, count / threads);

@@ -13,6 +13,7 @@
 
 #include "scallop/bezier.hpp"
 #include "scallop/error.hpp"
+#include "scallop/parallel.hpp"
 #include "scallop/surface.hpp"
 
 namespace scallop {
@@ -418,7 +419,7 @@ ToolPath liftToDropEnvelope(const SurfaceDistance& distance, const ToolPath& pat
     }
   };
   const std::size_t threads = std::min<std::size_t>(
-      path.passes.size(), options.threads > 0 ? options.threads : std::max(1u, std::thread::hardware_concurrency()));
+      path.passes.size(), threadCount(options.threads));
   {
     std::vector<std::jthread> pool;
     for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(work);

@@ -25,6 +25,7 @@
 #include <fmt/format.h>
 
 #include "scallop/error.hpp"
+#include "scallop/parallel.hpp"
 
 namespace scallop {
 
@@ -1589,7 +1590,7 @@ GougeReport gougeCheck(const SurfaceDistance& distance, const ToolPath& path, do
     }
   };
   const std::size_t threads = std::clamp<std::size_t>(
-      options.threads > 0 ? options.threads : std::thread::hardware_concurrency(), 1, blocks.size());
+      threadCount(options.threads), 1, blocks.size());
   {
     // Blocks dealt round-robin: thread t takes t, t + threads, ... (the work per block is
     // alike); each writes only its own blocks.

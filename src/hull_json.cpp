@@ -46,7 +46,7 @@ Json pathElementJson(const PathElement& element) {
   return json;
 }
 
-Json statsJson(const ScallopHull& result, std::size_t vertexCount, double seconds) {
+Json statsJson(const ScallopHull& result, std::size_t vertexCount) {
   std::size_t links = 0;
   for (const HullElement& element : result.hull) {
     links += element.kind == HullElementKind::link ? 1 : 0;
@@ -55,14 +55,13 @@ Json statsJson(const ScallopHull& result, std::size_t vertexCount, double second
   json["vertices"] = vertexCount;
   json["links"] = links;
   json["lids"] = result.hull.size() - links;
-  json["seconds"] = seconds;
   json["stack_pushes"] = result.stats.pushes;
   json["stack_pops"] = result.stats.pops;
   json["comparisons"] = result.stats.comparisons;
   return json;
 }
 
-Json documentJson(const ScallopHull& result, std::size_t vertexCount, double seconds,
+Json documentJson(const ScallopHull& result, std::size_t vertexCount,
                   std::optional<std::span<const Point2>> polyline) {
   Json document;
   document["radius"] = radiusJson(result.radius);
@@ -75,7 +74,7 @@ Json documentJson(const ScallopHull& result, std::size_t vertexCount, double sec
     Json& points = document["polyline"] = Json::array();
     for (const Point2& p : *polyline) points.push_back(pointJson(p));
   }
-  document["stats"] = statsJson(result, vertexCount, seconds);
+  document["stats"] = statsJson(result, vertexCount);
   return document;
 }
 
@@ -109,13 +108,12 @@ std::string dumpOneElementPerLine(const Json& document) {
 
 }  // namespace
 
-std::string hullToJson(const ScallopHull& result, std::size_t vertexCount, double seconds) {
-  return dumpOneElementPerLine(documentJson(result, vertexCount, seconds, std::nullopt));
+std::string hullToJson(const ScallopHull& result, std::size_t vertexCount) {
+  return dumpOneElementPerLine(documentJson(result, vertexCount, std::nullopt));
 }
 
-std::string hullToJson(const ScallopHull& result, std::size_t vertexCount, double seconds,
-                       std::span<const Point2> polyline) {
-  return dumpOneElementPerLine(documentJson(result, vertexCount, seconds, polyline));
+std::string hullToJson(const ScallopHull& result, std::size_t vertexCount, std::span<const Point2> polyline) {
+  return dumpOneElementPerLine(documentJson(result, vertexCount, polyline));
 }
 
 }  // namespace scallop

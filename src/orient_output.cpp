@@ -105,7 +105,6 @@ Json documentJson(const OptimalSlicing& result, double toleranceDeg) {
   } else {
     document["coverage"] = nullptr;
   }
-  document["seconds"] = result.seconds;
   return document;
 }
 
@@ -950,8 +949,6 @@ std::string orientationToJson(const OptimalSlicing& result, double toleranceDeg)
 
 std::string trimmedOrientationToJson(const OptimalSlicing& result, double toleranceDeg, const TrimmedFacts& facts) {
   Json document = documentJson(result, toleranceDeg);
-  const Json seconds = document["seconds"];
-  document.erase("seconds");
   Json trimmed;
   trimmed["faces"] = facts.faces;
   trimmed["inside_pieces"] = facts.insidePieces;
@@ -965,15 +962,12 @@ std::string trimmedOrientationToJson(const OptimalSlicing& result, double tolera
     trimmed["alpha_upper_deg"] = bounds ? Json(toDegrees(facts.inside->alphaRad)) : Json(nullptr);
     trimmed["upper_method"] = facts.inside->method;
     trimmed["upper_normal"] = {facts.inside->normal.x, facts.inside->normal.y, facts.inside->normal.z};
-    trimmed["seconds"] = facts.inside->seconds;
   } else {
     trimmed["alpha_upper_deg"] = nullptr;
     trimmed["upper_method"] = nullptr;
     trimmed["upper_normal"] = nullptr;
-    trimmed["seconds"] = 0.0;
   }
   document["trimmed"] = std::move(trimmed);
-  document["seconds"] = seconds;
   return json::format(document);
 }
 
@@ -1128,8 +1122,7 @@ void addEmptyCap(nlohmann::ordered_json& document, const MeshSlicing& result) {
 
 }  // namespace
 
-std::string meshOrientationToJson(const MeshSlicing& result, const StlMesh& mesh, const std::string& source,
-                                  double seconds) {
+std::string meshOrientationToJson(const MeshSlicing& result, const StlMesh& mesh, const std::string& source) {
   nlohmann::ordered_json document;
   document["input"] = "mesh";
   document["source"] = source;
@@ -1139,12 +1132,11 @@ std::string meshOrientationToJson(const MeshSlicing& result, const StlMesh& mesh
   document["zero_area_dropped"] = mesh.zeroAreaDropped;
   document["triangles"] = result.triangles;
   addEmptyCap(document, result);
-  document["seconds"] = seconds;
   return json::format(document);
 }
 
 std::string tessellationOrientationToJson(const MeshSlicing& result, const TessellationFacts& facts,
-                                          const std::string& source, double seconds) {
+                                          const std::string& source) {
   nlohmann::ordered_json document;
   document["input"] = "tessellation";
   document["source"] = source;
@@ -1157,7 +1149,6 @@ std::string tessellationOrientationToJson(const MeshSlicing& result, const Tesse
   addEmptyCap(document, result);
   document["alpha_is"] = "upper bound";
   document["certified"] = false;
-  document["seconds"] = seconds;
   return json::format(document);
 }
 

@@ -197,7 +197,6 @@ std::string pathsToJson(const PathsReport& report, const ToolPath& path) {
     verification["unreachable_area"] = v.unreachableArea;
     verification["unreachable_max_left"] = v.maxUnreachableLeft;
     verification["rapids_cutting"] = v.rapidsCutting;
-    verification["seconds"] = v.seconds;
     document["verification"] = std::move(verification);
   }
   if (report.tessellation) {
@@ -253,7 +252,6 @@ std::string pathsToJson(const PathsReport& report, const ToolPath& path) {
     orientation["alpha_deg"] = report.orientation->alphaRad * 180.0 / std::numbers::pi;
     orientation["certified"] = report.orientation->certified;
     orientation["boundary_segments"] = report.orientation->boundarySegments;
-    orientation["seconds"] = report.orientation->seconds;
     document["orientation"] = orientation;
   } else {
     document["orientation"] = nullptr;
@@ -297,7 +295,6 @@ std::string pathsToJson(const PathsReport& report, const ToolPath& path) {
   } else {
     document["motion"] = nullptr;
   }
-  document["seconds"] = report.seconds;
   Json passes = Json::array();
   auto finite = [](const Vec3& p) {
     return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);

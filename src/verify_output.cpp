@@ -119,11 +119,6 @@ std::string verifyToJson(const SimulationReport& r, const VerifySources& sources
   reach["points_classified"] = r.reachChecks;
   reach["budget_exhausted"] = r.reachBudgetExhausted;
   document["beyond_reach"] = reach;
-  Json seconds;
-  seconds["design"] = r.designSeconds;
-  seconds["sweep"] = r.sweepSeconds;
-  seconds["total"] = r.seconds;
-  document["seconds"] = seconds;
   document["swept_point_visits"] = r.sweptPointVisits;
   return json::format(document);
 }

@@ -6,15 +6,21 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <filesystem>
+#include <fstream>
 #include <string>
+#include <utility>
 #include <vector>
+
+#include <fmt/format.h>
 
 #include <nlohmann/json.hpp>
 
 #include "cli_fixture.hpp"
 #include "scallop/chain.hpp"
 #include "scallop/chain_io.hpp"
+#include "scallop/surface.hpp"
 
 namespace scallop {
 namespace {
@@ -225,6 +231,83 @@ TEST_F(Cli, InfiniteRadius) {
     EXPECT_TRUE(doc.at("toolpath").empty());
     EXPECT_FALSE(doc.at("hull").empty());
   }
+}
+
+// ---------------------------------------------------------------------------------------
+// Reproducible files: every command's outputs are the same bytes run after run and for
+// every thread count (parallel.hpp); no wall time is written into them.
+// ---------------------------------------------------------------------------------------
+
+// Every regular file under `dir`, by its path relative to it, with its content.
+std::vector<std::pair<std::string, std::string>> filesUnder(const fs::path& dir) {
+  std::vector<std::pair<std::string, std::string>> files;
+  for (const fs::directory_entry& entry : fs::recursive_directory_iterator(dir)) {
+    if (entry.is_regular_file()) files.emplace_back(fs::relative(entry.path(), dir).string(), readFile(entry.path()));
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+TEST_F(Cli, EveryCommandWritesTheSameBytesOnEveryRunAndThreadCount) {
+  // A 24 x 24 grid of paper-1's points as an ASCII STL (the mesh route).
+  const Surface paper1 = exampleSurface("paper-1");
+  std::string stl = "solid paper1\n";
+  const int n = 24;
+  const auto at = [&](int i, int j) { return point(paper1.patches[0], i / double(n), j / double(n)); };
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i)
+      for (const std::array<Vec3, 3>& t : {std::array<Vec3, 3>{at(i, j), at(i + 1, j), at(i + 1, j + 1)},
+                                           std::array<Vec3, 3>{at(i, j), at(i + 1, j + 1), at(i, j + 1)}}) {
+        stl += "facet normal 0 0 0\nouter loop\n";
+        for (const Vec3& v : t) stl += fmt::format("vertex {} {} {}\n", v.x, v.y, v.z);
+        stl += "endloop\nendfacet\n";
+      }
+  stl += "endsolid paper1\n";
+  const fs::path inputs = makeTempDir("scallop-cli-inputs-");
+  std::ofstream(inputs / "paper1.stl", std::ios::binary) << stl;
+  const std::string mesh = "'" + (inputs / "paper1.stl").string() + "'";
+  // Each command with every output it has (figures included), into the folder `o`.
+  const std::vector<std::string> commands = {
+      "hull --example figure2 --radius 1 --tolerance 0.01 --json o/h.json --svg o/h.svg",
+      "orient --example paper-1 --json o/o.json --svg-dir o/figures",
+      "paths --example paper-2 --strategy raster --tool-radius 0.25 --scallop-height 0.01 --json o/p.json "
+      "--gcode o/p.ngc --svg o/p.svg",
+      "plan --example paper-1 --tool-radius 0.25 --scallop-height 0.004 --out o/plan",
+      "plan " + mesh + " --units in --tool-radius 0.25 --scallop-height 0.004 --out o/mesh",
+      "verify --example paper-2 o/p.ngc --radius 0.25 --scallop-height 0.01 --json o/v.json --svg o/v.svg",
+  };
+  std::vector<std::pair<std::string, std::string>> first;
+  for (const char* threads : {"1", "2", "2", "0"}) {
+    SCOPED_TRACE(std::string("--threads ") + threads);
+    fs::remove_all(workDir_ / "o");
+    fs::create_directories(workDir_ / "o");
+    for (const std::string& command : commands) {
+      // The option goes before the command or after it: both are read.
+      const RunResult result = run(command.substr(0, command.find(' ')) + " --threads " + threads +
+                                   command.substr(command.find(' ')));
+      ASSERT_EQ(result.exitCode, 0) << command << ": " << result.err;
+    }
+    const std::vector<std::pair<std::string, std::string>> files = filesUnder(workDir_ / "o");
+    if (first.empty()) {
+      first = files;
+      EXPECT_GE(first.size(), 20u);  // reports, programs, JSON and every figure
+      for (const auto& [name, content] : first) EXPECT_EQ(content.find("seconds"), std::string::npos) << name;
+      continue;
+    }
+    ASSERT_EQ(files.size(), first.size());
+    for (std::size_t i = 0; i < files.size(); ++i) {
+      EXPECT_EQ(files[i].first, first[i].first);
+      EXPECT_TRUE(files[i].second == first[i].second) << files[i].first << " differs";
+    }
+  }
+  const RunResult before = run("--threads 1 hull --example figure2 --radius 1 --json -");
+  EXPECT_EQ(before.exitCode, 0) << before.err;
+  for (const char* bad : {"--threads -1", "--threads 2000", "--threads two"}) {
+    const RunResult refused = run(std::string("hull --example figure2 --radius 1 ") + bad);
+    EXPECT_EQ(refused.exitCode, 1) << bad;
+    EXPECT_NE(refused.err.find("--threads"), std::string::npos) << refused.err;
+  }
+  fs::remove_all(inputs);
 }
 
 TEST_F(Cli, VersionAndHelp) {

@@ -115,7 +115,7 @@ TEST(OrientJson, EveryKeyInOrderAndEveryNumberBitForBit) {
                         "normal", "alpha_deg", "certified", "certified_alpha_deg",
                         "certificate_cells", "refuted_alpha_deg", "method", "circle",
                         "sphere_circle", "pole",
-                        "tolerance_deg", "gauss_map", "medial_axis", "coverage", "seconds"}));
+                        "tolerance_deg", "gauss_map", "medial_axis", "coverage"}));
     std::vector<std::string> medialKeys;
     for (const auto& item : ordered.at("medial_axis").items()) medialKeys.push_back(item.key());
     EXPECT_EQ(medialKeys, (std::vector<std::string>{"edges", "rebuilds", "segments", "refinements"}));
@@ -157,7 +157,6 @@ TEST(OrientJson, EveryKeyInOrderAndEveryNumberBitForBit) {
     EXPECT_EQ(doc.at("medial_axis").at("segments").get<std::size_t>(), result.medialAxisSegments);
     EXPECT_EQ(doc.at("medial_axis").at("refinements").get<int>(), result.medialAxisRefinements);
     EXPECT_GT(result.medialAxisSegments, 0u);
-    expectSameDouble(doc.at("seconds"), result.seconds, "seconds");
   }
 }
 

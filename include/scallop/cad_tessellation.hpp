@@ -66,6 +66,7 @@
 #include <string>
 #include <vector>
 
+#include "scallop/parallel.hpp"
 #include "scallop/cad_import.hpp"
 #include "scallop/cut_simulation.hpp"
 #include "scallop/mesh.hpp"
@@ -99,7 +100,7 @@ struct CadTessellation {
 };
 
 struct ExactHeightOptions {
-  unsigned threads = 0;               ///< 0: std::thread::hardware_concurrency()
+  unsigned threads = 0;               ///< 0: threadCount() (parallel.hpp)
   std::size_t maxRays = 1'000'000;    ///< budget: vertical lines intersected
 };
 

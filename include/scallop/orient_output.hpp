@@ -24,7 +24,8 @@
 //                  "image_vertices", "coarse_band" (bool)}   counts (see GaussMap),
 //    "medial_axis": {"edges", "rebuilds", "segments" (of the final domain searched),
 //                    "refinements" (coarse-to-fine rounds)},
-//    "seconds": s}                           wall time of optimalSlicing
+//    }
+// No wall time (the CLI prints it on stderr): the same input gives the same bytes.
 //
 // Figures (fixed-point numbers only: no exponent, nan or inf; deterministic):
 //   gaussMapSphereSvg: the symmetrized Gauss map Omega on the unit sphere, in two
@@ -73,7 +74,7 @@ struct TrimmedFacts {
 
 /// orientationToJson of a part with trimmed faces: `result` is the slicing of all its pieces
 /// (inside and boundary: a superset of the faces' normals, so its N* keeps at least its
-/// certified alpha from every normal of the part), with, before "seconds", "trimmed":
+/// certified alpha from every normal of the part), with, at the end, "trimmed":
 /// {"faces", "inside_pieces", "boundary_pieces", "spread_deg", "largest_spread_deg",
 ///  "alpha_lower_deg" (the certified alpha, or alpha_deg when not certified),
 ///  "alpha_upper_deg" (alpha* of the inside pieces alone, a subset of the normals: no
@@ -81,15 +82,14 @@ struct TrimmedFacts {
 ///  pieces, or when it bounds nothing), "upper_method" (that slicing's method: "covered" when
 ///  the inside pieces' normals provably cover the sphere, alpha* = 0; "open" when their Gauss
 ///  map leaves no direction free without such a proof: alpha_upper_deg is then null),
-///  "upper_normal" (that slicing's N*, or null), "seconds" (of that slicing)}.
+///  "upper_normal" (that slicing's N*, or null)}.
 std::string trimmedOrientationToJson(const OptimalSlicing& result, double toleranceDeg, const TrimmedFacts& facts);
 
 /// The JSON form of a mesh's optimal slicing (mesh_slicing.hpp): {"input": "mesh", "source",
 /// "format": "binary"|"ascii", "units", "triangles_read", "zero_area_dropped", "triangles" (of
 /// positive area), "distinct_normals", "hull_facets", "great_circle", "normal": [x, y, z],
-/// "alpha_deg", "seconds"}; numbers round-trip exactly.
-std::string meshOrientationToJson(const MeshSlicing& result, const StlMesh& mesh, const std::string& source,
-                                  double seconds);
+/// "alpha_deg"}; numbers round-trip exactly.
+std::string meshOrientationToJson(const MeshSlicing& result, const StlMesh& mesh, const std::string& source);
 
 /// What `scallop orient` says of a STEP or IGES part oriented by its tessellation
 /// (cad_tessellation.hpp): the facts of the mesh beside the facets' optimum.
@@ -106,7 +106,7 @@ struct TessellationFacts {
 /// optimum over the part's sampled exact normals (optimalNormalSlicing): alpha_deg is then an
 /// upper bound of the part's alpha* ("alpha_is": "upper bound"), not certified.
 std::string tessellationOrientationToJson(const MeshSlicing& result, const TessellationFacts& facts,
-                                          const std::string& source, double seconds);
+                                          const std::string& source);
 
 /// The symmetrized Gauss map and the optimal circle on the unit sphere (see above).
 std::string gaussMapSphereSvg(const OptimalSlicing& result);

@@ -10,6 +10,8 @@
 //       double precision); positions are ball centres in the surface's units. Moves:
 //       {"line": [x, y, z]} or {"arc": {"end": [..], "center": [..], "plane": "xy"|"zx"|"yz",
 //       "clockwise": bool}} (clockwise as G2: seen from the plane normal's positive end).
+//       No wall times (the `seconds` fields below are for callers; the CLI prints them on
+//       stderr): the same input gives the same bytes.
 // SVG:  fixed-point coordinates only (never an exponent, nan or inf); deterministic.
 
 #include <cstddef>

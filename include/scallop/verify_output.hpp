@@ -9,7 +9,8 @@
 //              "unknown_start", "max_arc_radius_mismatch"},
 //    "gouge": {"max", "at": [x, y, z] | null, "points", "area", "over_tolerance": bool},
 //    "scallop": {"max", "at": [x, y, z] | null, "p99", "mean", "uncut_points", "uncut_area"},
-//    "seconds": {"design", "sweep", "total"}, "swept_point_visits"}
+//    "swept_point_visits"}
+// No wall times (the CLI prints them on stderr): the same program gives the same bytes.
 // Lengths in the surface's units, areas in units^2; numbers shortest round-trip (full
 // double precision), never NaN or infinite (a missing location is null).
 //

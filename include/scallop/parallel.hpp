@@ -1,0 +1,47 @@
+#pragma once
+// How many threads scallop's parallel loops use.
+//
+// Contract
+// --------
+// Every parallel part of scallop (lifting passes to the drop envelope, the gouge check's
+// sample blocks, the cut simulation's clearance and reach checks, the exact heights of a CAD
+// part) takes its thread count from its options' `threads` field; 0 there means
+// threadCount() below. Each of them writes only its own slots and combines them in a fixed
+// order, so results are the same, bit for bit, for every thread count (tests/cli_test.cpp
+// compares the files every command writes at 1 and 2 threads).
+//
+// threadCount(): the process-wide default, set by setThreadCount (the CLI's `--threads N`);
+// 0 (the initial setting) means every core: std::thread::hardware_concurrency(), or 1 when
+// that is unknown. Thread-safe (an atomic); meant to be set once, before the work starts.
+//
+// Why the standard library and not TBB: the parallel parts are a handful of loops over
+// independent items whose cost is known up front (passes, sample blocks, grid rows); a pool
+// of std::jthreads pulling indices from an atomic counter balances them, keeps the result
+// independent of the schedule, and adds no dependency to the core library (Debian's TBB is
+// in the tree only because OpenCASCADE's CMake files name it).
+
+#include <algorithm>
+#include <atomic>
+#include <cstddef>
+#include <thread>
+
+namespace scallop {
+
+namespace detail {
+inline std::atomic<std::size_t> threadCountSetting{0};
+}  // namespace detail
+
+/// Sets the default thread count of every parallel part (0: every core).
+inline void setThreadCount(std::size_t threads) { detail::threadCountSetting.store(threads); }
+
+/// The default thread count: setThreadCount's value, or every core when that is 0 (>= 1).
+inline std::size_t threadCount() {
+  const std::size_t set = detail::threadCountSetting.load();
+  if (set > 0) return set;
+  return std::max<std::size_t>(1, std::thread::hardware_concurrency());
+}
+
+/// `requested` (an option's `threads` field) when positive, else threadCount().
+inline std::size_t threadCount(std::size_t requested) { return requested > 0 ? requested : threadCount(); }
+
+}  // namespace scallop
