@@ -50,6 +50,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// Every file `plan` writes into its --out directory (the mesh route writes the first four).
+const OwnedNames kPlanOutputs = {"toolpath.ngc", "toolpath.gcode", "report.json",   "verify.svg",
+                                 "paths.svg",    "paths-plan.svg", "gauss-map.svg", "stereographic.svg"};
+
 struct PlanOptions {
   SurfaceSource surface;
   std::string strategy;  // empty: contour for a surface, raster for a mesh
@@ -240,11 +244,11 @@ void runPlanMesh(const PlanOptions& options, MeshJob job) {
   report.verification = verificationSummary(simulated, *simulation.stockAllowance);
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   progress("writing the report");
-  const fs::path dir = options.out;
-  writeOutputs({{(dir / programName).string(), program},
-                {(dir / "report.json").string(), pathsToJson(report, paths.path)},
-                {(dir / "verify.svg").string(), verifySvg(simulated, {path, programName, 0, 0.0})}},
-               options.out);
+  replaceDirectory(options.out,
+                   {{programName, program},
+                    {"report.json", pathsToJson(report, paths.path)},
+                    {"verify.svg", verifySvg(simulated, {path, programName, 0, 0.0})}},
+                   kPlanOutputs);
   const std::string units(unitsName(mesh.units));
   fmt::print(stderr,
              "scallop plan: raster on {}{}: {} triangles, {} lines {:.5g} to {:.5g} {} apart, tool-centre length {:.4f} {}, "
@@ -276,6 +280,7 @@ void runPlanMesh(const PlanOptions& options, MeshJob job) {
 void runPlan(const PlanOptions& options) {
   if (!options.spacing.empty() && !options.scallopHeight.empty())
     throw CLI::ValidationError("plan", "give at most one of --spacing and --scallop-height");
+  checkReplaceableDirectory(options.out, kPlanOutputs);  // before the work, not after it
   if (isStlSource(options.surface.input)) {
     if (options.surface.exactTrims)
       throw Error(fmt::format("{}: --exact-trims is for STEP and IGES parts; an STL file is a mesh",
@@ -392,7 +397,6 @@ void runPlan(const PlanOptions& options) {
   }
 
   progress("writing the report and figures");
-  const fs::path dir = options.out;
   const std::string figureTitle = fmt::format(
       "scallop plan: {} strategy on {}, R = {} {}, spacing {:.5g}, {} passes", job.strategy,
       source, job.toolRadius, unitsName(surface.units), report.spacing, result.path.passes.size());
@@ -401,16 +405,17 @@ void runPlan(const PlanOptions& options) {
   report.plungeFeedRate = gcodeOptions.plungeFeedRate;
   report.rapidRate = rapidRate;
   report.verification = verificationSummary(simulated, *simulation.stockAllowance);
-  std::vector<OutputFile> outputs{
-      {(dir / programName).string(), program},
-      {(dir / "report.json").string(), pathsToJson(report, result.path)},
-      {(dir / "verify.svg").string(), verifySvg(simulated, {source, programName, 0, 0.0})},
-      {(dir / "paths.svg").string(), pathsSvg(surface, result.contactCurves, result.path, figureTitle, false)},
-      {(dir / "paths-plan.svg").string(), pathsSvg(surface, result.contactCurves, result.path, figureTitle, true)},
-      {(dir / "gauss-map.svg").string(), gaussMapSphereSvg(orientation)},
-      {(dir / "stereographic.svg").string(), stereographicSvg(orientation)},
-  };
-  writeOutputs(outputs, options.out);
+  replaceDirectory(options.out,
+                   {
+                       {programName, program},
+                       {"report.json", pathsToJson(report, result.path)},
+                       {"verify.svg", verifySvg(simulated, {source, programName, 0, 0.0})},
+                       {"paths.svg", pathsSvg(surface, result.contactCurves, result.path, figureTitle, false)},
+                       {"paths-plan.svg", pathsSvg(surface, result.contactCurves, result.path, figureTitle, true)},
+                       {"gauss-map.svg", gaussMapSphereSvg(orientation)},
+                       {"stereographic.svg", stereographicSvg(orientation)},
+                   },
+                   kPlanOutputs);
   const PathStats& s = report.stats;
   std::string gouge;
   if (report.envelope && report.envelope->verticesLifted > 0)

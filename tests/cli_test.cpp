@@ -7,6 +7,9 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -290,7 +293,7 @@ TEST_F(Cli, EveryCommandWritesTheSameBytesOnEveryRunAndThreadCount) {
     const std::vector<std::pair<std::string, std::string>> files = filesUnder(workDir_ / "o");
     if (first.empty()) {
       first = files;
-      EXPECT_GE(first.size(), 20u);  // reports, programs, JSON and every figure
+      EXPECT_EQ(first.size(), 20u);  // reports, programs, JSON and every figure
       for (const auto& [name, content] : first) EXPECT_EQ(content.find("seconds"), std::string::npos) << name;
       continue;
     }
@@ -308,6 +311,62 @@ TEST_F(Cli, EveryCommandWritesTheSameBytesOnEveryRunAndThreadCount) {
     EXPECT_NE(refused.err.find("--threads"), std::string::npos) << refused.err;
   }
   fs::remove_all(inputs);
+}
+
+// `plan --out` over an earlier result, killed (SIGKILL) at moments spread over its run: the
+// directory holds the old result or the new one, whole, never a mix and never a temporary
+// (a kill leaves at most a hidden sibling). A directory holding a file plan does not write is
+// refused before any work and left as it was.
+TEST_F(Cli, PlanOutIsTheOldResultOrTheNewOneUnderAKillAtAnyMoment) {
+  const std::string common = "plan --example paper-1 --tool-radius 0.25 --quiet --threads 1 --scallop-height ";
+  const auto started = std::chrono::steady_clock::now();
+  ASSERT_EQ(run(common + "0.01 --out reference").exitCode, 0);
+  const double runSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  ASSERT_EQ(run(common + "0.02 --out old").exitCode, 0);
+  const auto newFiles = filesUnder(workDir_ / "reference");
+  const auto oldFiles = filesUnder(workDir_ / "old");
+  ASSERT_EQ(newFiles.size(), 7u);
+  ASSERT_FALSE(newFiles == oldFiles);
+  int sawOld = 0, sawNew = 0;
+  for (int k = 0; k <= 12; ++k) {
+    const double delay = runSeconds * 0.1 * k;  // from the start to past the end of the run
+    SCOPED_TRACE(delay);
+    const std::string command =
+        fmt::format("cd '{}' && ('{}' {}0.01 --out old & pid=$!; sleep {}; kill -9 $pid; wait $pid) >/dev/null 2>&1",
+                    workDir_.string(), SCALLOP_CLI_PATH, common, delay);
+    (void)std::system(command.c_str());  // killed or finished: the directory is what is judged
+    const auto files = filesUnder(workDir_ / "old");
+    if (files == oldFiles) {
+      ++sawOld;
+    } else if (files == newFiles) {
+      ++sawNew;
+      ASSERT_EQ(run(common + "0.02 --out old").exitCode, 0);  // the old result back
+    } else {
+      ADD_FAILURE() << "a mix of the two results, or a temporary, in old/ (" << files.size() << " files)";
+    }
+    for (const fs::directory_entry& entry : fs::directory_iterator(workDir_)) {
+      const std::string name = entry.path().filename().string();
+      EXPECT_TRUE(name == "old" || name == "reference" || name.rfind(".old.tmp-", 0) == 0) << name;
+    }
+  }
+  EXPECT_GT(sawOld, 0);  // a kill at 0 s comes before any output
+  std::printf("[          ] %d kills left the old result, %d the new one\n", sawOld, sawNew);
+  // Not killed: the new result, whole.
+  ASSERT_EQ(run(common + "0.01 --out old").exitCode, 0);
+  EXPECT_TRUE(filesUnder(workDir_ / "old") == newFiles);
+  // A file of the user's in the directory: refused at once, nothing touched.
+  write("old/notes.txt", "mine");
+  const RunResult refused = run(common + "0.02 --out old");
+  EXPECT_EQ(refused.exitCode, 1);
+  EXPECT_NE(refused.err.find("'old' holds 'notes.txt'"), std::string::npos) << refused.err;
+  EXPECT_EQ(refused.err.find("scallop plan: "), std::string::npos) << refused.err;  // no work began
+  EXPECT_EQ(filesUnder(workDir_ / "old").size(), 8u);
+  EXPECT_EQ(readFile(workDir_ / "old" / "notes.txt"), "mine");
+  for (const char* out : {".", "..", "old/notes.txt"}) {
+    const RunResult bad = run(common + "0.02 --out " + out);
+    EXPECT_EQ(bad.exitCode, 1) << out;
+    EXPECT_NE(bad.err.find(std::string("'") + out + "'"), std::string::npos) << bad.err;
+  }
 }
 
 TEST_F(Cli, VersionAndHelp) {
