@@ -2,6 +2,7 @@
 // subcommand, and is the one place errors are caught: each is printed once, as
 // "scallop: error: <message>", and the exit status is 1, usage errors included.
 
+#include <cctype>
 #include <cstdio>
 #include <exception>
 #include <string>
@@ -21,6 +22,39 @@ namespace {
 int reportError(const char* message) {
   fmt::print(stderr, "scallop: error: {}\n", message);
   return 1;
+}
+
+// The first option on the command line that neither the command nor scallop itself knows.
+// CLI11 checks the required options and the positionals' count before it looks for unknown
+// ones, so a misspelt `--tool-radius` for verify's `--radius` read as "--radius is required"
+// or "FILES: At Most 2 required but received 3" (its value taken for a file). Negative
+// numbers (-2.5) are values; after "--" everything is.
+struct UnknownOption {
+  std::string name;     // empty: none
+  std::string command;  // "scallop" or "scallop <command>"
+};
+
+UnknownOption unknownOption(const CLI::App& app, int argc, char** argv) {
+  const CLI::App* command = nullptr;
+  for (int i = 1; i < argc; ++i) {
+    const std::string token = argv[i];
+    if (token == "--") break;
+    if (command == nullptr) {
+      for (const CLI::App* sub : app.get_subcommands({})) {
+        if (sub->check_name(token)) command = sub;
+      }
+      if (command != nullptr) continue;
+    }
+    if (token.size() < 2 || token[0] != '-' || std::isdigit(static_cast<unsigned char>(token[1])) != 0 ||
+        token[1] == '.')
+      continue;
+    // --name=value and -xVALUE name --name and -x.
+    const std::string name = token[1] == '-' ? token.substr(0, token.find('=')) : token.substr(0, 2);
+    const bool known = app.get_option_no_throw(name) != nullptr ||
+                       (command != nullptr && command->get_option_no_throw(name) != nullptr);
+    if (!known) return {name, command != nullptr ? "scallop " + command->get_name() : std::string("scallop")};
+  }
+  return {};
 }
 
 }  // namespace
@@ -48,6 +82,10 @@ int main(int argc, char** argv) {
   int status = 0;  // a command's own non-zero status that is not an error (verify --fail-on-gouge)
   scallop::cli::addVerifyCommand(app, status);
   try {
+    if (const UnknownOption unknown = unknownOption(app, argc, argv); !unknown.name.empty())
+      return reportError(fmt::format("unknown option '{}' for {} (see {} --help)", unknown.name, unknown.command,
+                                     unknown.command)
+                             .c_str());
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
     // --help and --version are "errors" with exit code 0: CLI11 prints them. Every other one

@@ -134,6 +134,21 @@ TEST_F(Cli, UsageErrorsFailWithoutOutput) {
     EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
     EXPECT_EQ(listing(), std::vector<std::string>{"in.txt"});
   }
+  // An unknown option is named as such, with its command, whatever else is wrong or missing
+  // (CLI11 alone said "--radius is required" or "FILES: At Most 2 required but received 3").
+  for (const auto& [arguments, said] : std::vector<std::pair<std::string, std::string>>{
+           {"verify --example paper-1 p.ngc --tool-radius 2", "unknown option '--tool-radius' for scallop verify"},
+           {"hull --example figure2 -r 1 --bogus 3", "unknown option '--bogus' for scallop hull"},
+           {"plan --example paper-1 --tool-radius=1 -x", "unknown option '-x' for scallop plan"},
+           {"--threads 1 --bogus hull in.txt -r 1", "unknown option '--bogus' for scallop (see scallop --help)"}}) {
+    SCOPED_TRACE(arguments);
+    const RunResult result = run(arguments);
+    EXPECT_EQ(result.exitCode, 1);
+    EXPECT_NE(result.err.find(said), std::string::npos) << result.err;
+    EXPECT_EQ(listing(), std::vector<std::string>{"in.txt"});
+  }
+  // Negative numbers are values, not options: the radius is what is wrong.
+  EXPECT_NE(run("hull in.txt -r -2.5").err.find("invalid radius '-2.5'"), std::string::npos);
   // Help and the version are not errors.
   for (const char* arguments : {"--help", "hull --help", "--version"}) {
     SCOPED_TRACE(arguments);
