@@ -5,8 +5,8 @@
 
 #include <array>
 #include <cmath>
+#include <optional>
 #include <random>
-#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -178,19 +178,18 @@ TEST(GcodeReader, AgreesWithLinuxCncOnRandomPrograms) {
     const GcodeProgram program = parseGcodeProgram(text, "random.ngc");
     const test::Rs274Run run = test::runRs274(rs274, text);
     ASSERT_EQ(run.exitCode, 0) << run.err << "\n" << text;
-    static const std::regex call(R"(^\s*\d+ N\.\.\.\.\. ([A-Z_]+)\((.*)\)\s*$)");
     std::vector<std::pair<std::string, std::vector<double>>> calls;
     std::string plane = "CANON_PLANE_XY";
     std::stringstream lines(run.out);
     std::string line;
     while (std::getline(lines, line)) {
-      std::smatch match;
-      if (!std::regex_match(line, match, call)) continue;
-      const std::string name = match[1];
-      if (name == "SELECT_PLANE") plane = match[2];
+      const std::optional<test::CanonLine> call = test::parseCanonLine(line);
+      if (!call) continue;
+      const std::string& name = call->name;
+      if (name == "SELECT_PLANE") plane = call->arguments;
       if (name != "STRAIGHT_TRAVERSE" && name != "STRAIGHT_FEED" && name != "ARC_FEED") continue;
       std::vector<double> args;
-      std::stringstream list(match[2].str());
+      std::stringstream list(call->arguments);
       std::string arg;
       while (std::getline(list, arg, ',')) args.push_back(std::stod(arg));
       calls.push_back({name == "ARC_FEED" ? plane : name, args});

@@ -313,18 +313,17 @@ double number(const std::string& text) {
 
 // Parses rs274's canonical output; any other line is reported in `unexpected`.
 std::vector<CanonCall> parseCanon(const std::string& out, std::vector<std::string>& unexpected) {
-  static const std::regex call(R"(^\s*\d+ N\.\.\.\.\. ([A-Z_0-9]+)\((.*)\)\s*$)");
   std::vector<CanonCall> calls;
   for (const std::string& line : lines(out)) {
-    std::smatch match;
-    if (!std::regex_match(line, match, call)) {
+    const std::optional<test::CanonLine> call = test::parseCanonLine(line);
+    if (!call) {
       if (!line.empty()) unexpected.push_back(line);
       continue;
     }
     CanonCall c;
-    c.name = match[1];
+    c.name = call->name;
     c.text = line;
-    std::stringstream args(match[2].str());
+    std::stringstream args(call->arguments);
     std::string arg;
     while (std::getline(args, arg, ',')) {
       const auto first = arg.find_first_not_of(' ');

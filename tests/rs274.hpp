@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -73,6 +74,34 @@ inline Rs274Run runRs274(const std::string& rs274, const std::string& program) {
   run.err = slurp(dir / "err.txt");
   fs::remove_all(dir);
   return run;
+}
+
+// One canonical call of rs274's output, "   12 N..... STRAIGHT_FEED(1.0000, 2.0000, ...)":
+// its name and the text between its parentheses; none for any other line. Read by hand, not
+// with std::regex: libstdc++'s matcher recurses once per character, and on a long call's
+// arguments that overflowed the stack under AddressSanitizer.
+struct CanonLine {
+  std::string name;
+  std::string arguments;
+};
+
+inline std::optional<CanonLine> parseCanonLine(const std::string& line) {
+  const auto isSpace = [](char c) { return c == ' ' || c == '\t' || c == '\r'; };
+  std::size_t i = 0;
+  while (i < line.size() && isSpace(line[i])) ++i;
+  const std::size_t digits = i;
+  while (i < line.size() && line[i] >= '0' && line[i] <= '9') ++i;
+  const std::string marker = " N..... ";
+  if (i == digits || line.compare(i, marker.size(), marker) != 0) return std::nullopt;
+  i += marker.size();
+  const std::size_t nameStart = i;
+  while (i < line.size() && ((line[i] >= 'A' && line[i] <= 'Z') || (line[i] >= '0' && line[i] <= '9') || line[i] == '_'))
+    ++i;
+  if (i == nameStart || i >= line.size() || line[i] != '(') return std::nullopt;
+  std::size_t end = line.size();
+  while (end > i && isSpace(line[end - 1])) --end;
+  if (end <= i + 1 || line[end - 1] != ')') return std::nullopt;
+  return CanonLine{line.substr(nameStart, i - nameStart), line.substr(i + 1, end - 1 - (i + 1))};
 }
 
 }  // namespace scallop::test
