@@ -526,7 +526,10 @@ class Prover {
   // whose normal cone (widened by 0.05 rad) holds +-c; distinct, steepest first.
   std::vector<Preimage> findPreimages(const Vec3& c, const std::vector<Preimage>& hints,
                                       bool useSeeds) {
-    const auto [e1, e2] = frameAbout(c);
+    // Named, not a structured binding: the lambda below captures them (clang 14, which the
+    // fuzz build uses, cannot capture structured bindings).
+    const auto frame = frameAbout(c);
+    const Vec3 e1 = frame.first, e2 = frame.second;
     std::vector<Preimage> found;
     auto tryFrom = [&](std::size_t patch, double sign, double u, double v) {
       double stretch = 0.0, largest = 0.0;

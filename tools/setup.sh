@@ -2,11 +2,12 @@
 # scallop set-up on Debian 12: install what is missing, build, then run the demo or the tests.
 #   bash tools/setup.sh demo   # build, then the main job `scallop plan` -> scallop-out/
 #   bash tools/setup.sh test   # also installs linuxcnc-uspace; build, then all tests (ctest)
+#   bash tools/setup.sh packages  # the test's packages only (tools/sanitize.sh)
 # Environment: BUILD_DIR (default build), JOBS (default: number of cores), SCALLOP_WERROR=ON.
 set -euo pipefail
 
 mode="${1:-demo}"
-case "$mode" in demo|test|build) ;; *) echo "usage: $0 demo|test|build" >&2; exit 2 ;; esac
+case "$mode" in demo|test|build|packages) ;; *) echo "usage: $0 demo|test|build|packages" >&2; exit 2 ;; esac
 
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${BUILD_DIR:-$root/build}"
@@ -22,7 +23,7 @@ packages=(build-essential cmake pkg-config nlohmann-json3-dev libfmt-dev libcli1
 # The tests check the G-code writer with LinuxCNC's own interpreter, rs274 (gcode_test.cpp
 # fails without it). It runs headless; with --no-install-recommends it still pulls in about
 # 100 packages (Tcl/Tk, Python, GTK libraries): some 75 MB to download, 255 MB on disk.
-if [ "$mode" = test ]; then packages+=(linuxcnc-uspace); fi
+if [ "$mode" = test ] || [ "$mode" = packages ]; then packages+=(linuxcnc-uspace); fi
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -36,6 +37,8 @@ if [ "${#missing[@]}" -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive "${sudo[@]}" apt-get install -y -qq --no-install-recommends \
     "${missing[@]}" >/dev/null
 fi
+
+if [ "$mode" = packages ]; then exit 0; fi  # tools/sanitize.sh: the test packages only
 
 cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release \
   -DSCALLOP_WERROR="${SCALLOP_WERROR:-OFF}" >/dev/null
