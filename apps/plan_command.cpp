@@ -14,7 +14,6 @@
 #include <limits>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <memory>
 #include <numbers>
 #include <optional>
@@ -47,8 +46,6 @@
 
 namespace scallop::cli {
 namespace {
-
-namespace fs = std::filesystem;
 
 // Every file `plan` writes into its --out directory (the mesh route writes the first four).
 const OwnedNames kPlanOutputs = {"toolpath.ngc", "toolpath.gcode", "report.json",   "verify.svg",

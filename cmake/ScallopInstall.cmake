@@ -13,16 +13,22 @@ set(SCALLOP_INSTALL_CMAKEDIR "${CMAKE_INSTALL_LIBDIR}/cmake/scallop"
     CACHE STRING "Where scallopConfig.cmake is installed (relative to the prefix)")
 mark_as_advanced(SCALLOP_INSTALL_CMAKEDIR)
 
-install(TARGETS scallop_core scallop_io scallop
-  EXPORT scallopTargets
-  ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT scallop_Development
-  LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT scallop_Runtime
-          NAMELINK_COMPONENT scallop_Development
-  RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT scallop_Runtime)
-install(EXPORT scallopTargets
-  NAMESPACE scallop::
-  DESTINATION ${SCALLOP_INSTALL_CMAKEDIR}
-  COMPONENT scallop_Development)
+# The targets of one export set (archives and headers' link files for development, shared
+# libraries and programs at run time) and the set's targets file, as scallop::<name>.
+function(scallop_install_export export_set)
+  install(TARGETS ${ARGN}
+    EXPORT ${export_set}
+    ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT scallop_Development
+    LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT scallop_Runtime
+            NAMELINK_COMPONENT scallop_Development
+    RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT scallop_Runtime)
+  install(EXPORT ${export_set}
+    NAMESPACE scallop::
+    DESTINATION ${SCALLOP_INSTALL_CMAKEDIR}
+    COMPONENT scallop_Development)
+endfunction()
+
+scallop_install_export(scallopTargets scallop_core scallop_io scallop)
 
 # The public headers, cad_*.hpp only with scallop::cad. The globs run at install time.
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/scallop
@@ -33,16 +39,7 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/scallop
 if(SCALLOP_BUILD_CAD)
   # An export set of its own, so that find_package(scallop) looks for OpenCASCADE only
   # when scallop::cad is asked for.
-  install(TARGETS scallop_cad
-    EXPORT scallopCadTargets
-    ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT scallop_Development
-    LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT scallop_Runtime
-            NAMELINK_COMPONENT scallop_Development
-    RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT scallop_Runtime)
-  install(EXPORT scallopCadTargets
-    NAMESPACE scallop::
-    DESTINATION ${SCALLOP_INSTALL_CMAKEDIR}
-    COMPONENT scallop_Development)
+  scallop_install_export(scallopCadTargets scallop_cad)
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/scallop
     DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
     COMPONENT scallop_Development
