@@ -2,12 +2,15 @@
 
 #include <charconv>
 #include <cmath>
+#include <sstream>
+#include <vector>
 #include <string_view>
 #include <system_error>
 
 #include <fmt/format.h>
 
 #include "scallop/error.hpp"
+#include "scallop/vector.hpp"
 
 namespace scallop::cli {
 
@@ -40,6 +43,22 @@ double parsePositive(const std::string& text, const char* what, const char* expe
     throw Error(fmt::format("invalid {} '{}': must be positive", what, text));
   }
   return value;
+}
+
+Vec3 parseNormal(const std::string& text) {
+  std::vector<std::string> parts;
+  std::stringstream stream(text);
+  for (std::string part; std::getline(stream, part, ',');) parts.push_back(part);
+  if (parts.size() != 3 || text.back() == ',')
+    throw Error(fmt::format("invalid normal '{}': expected X,Y,Z (three numbers) or auto", text));
+  const Vec3 n{parseFinite(parts[0], "normal x", "a number"),
+               parseFinite(parts[1], "normal y", "a number"),
+               parseFinite(parts[2], "normal z", "a number")};
+  if (n.x == 0.0 && n.y == 0.0 && n.z == 0.0)
+    throw Error(fmt::format("invalid normal '{}': the zero vector has no direction", text));
+  if (!std::isfinite(norm(n)))
+    throw Error(fmt::format("invalid normal '{}': too large", text));
+  return n;
 }
 
 }  // namespace scallop::cli

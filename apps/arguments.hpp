@@ -4,6 +4,8 @@
 
 #include <string>
 
+#include "scallop/vector.hpp"
+
 namespace scallop::cli {
 
 /// A positive finite number: the whole of `text` (std::from_chars: locale-independent, no
@@ -13,5 +15,8 @@ double parsePositive(const std::string& text, const char* what, const char* expe
 
 /// Any finite number, with the same rules and errors as parsePositive.
 double parseFinite(const std::string& text, const char* what, const char* expected);
+
+/// Parses "X,Y,Z" (three finite numbers, not all zero) for --normal.
+Vec3 parseNormal(const std::string& text);
 
 }  // namespace scallop::cli

@@ -24,7 +24,7 @@
 #include "surface_options.hpp"
 #include "linking_options.hpp"
 #include "mesh_job.hpp"
-#include "toolpath_job.hpp"
+#include "scallop/toolpath_job.hpp"
 
 namespace scallop::cli {
 namespace {

@@ -4,8 +4,8 @@
 # scallop.pc) and scallop_Runtime (the scallop program; shared libraries when
 # BUILD_SHARED_LIBS). Tests and benchmarks are not installed.
 #
-# The CMake package: find_package(scallop) gives scallop::core, scallop::io and
-# scallop::scallop (both); find_package(scallop COMPONENTS cad) adds scallop::cad (and finds
+# The CMake package: find_package(scallop) gives scallop::core, scallop::io, scallop::jobs
+# and scallop::scallop (all three); find_package(scallop COMPONENTS cad) adds scallop::cad (and finds
 # OpenCASCADE) when scallop was built with SCALLOP_BUILD_CAD.
 include(CMakePackageConfigHelpers)
 
@@ -28,7 +28,7 @@ function(scallop_install_export export_set)
     COMPONENT scallop_Development)
 endfunction()
 
-scallop_install_export(scallopTargets scallop_core scallop_io scallop)
+scallop_install_export(scallopTargets scallop_core scallop_io scallop_jobs scallop)
 
 # The public headers, cad_*.hpp only with scallop::cad. The globs run at install time.
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/scallop

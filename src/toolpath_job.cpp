@@ -1,22 +1,20 @@
-#include "toolpath_job.hpp"
+#include "scallop/toolpath_job.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <numbers>
-#include <sstream>
 
 #include <fmt/format.h>
 
-#include "arguments.hpp"
 #include "scallop/contour.hpp"
 #include "scallop/cusp.hpp"
 #include "scallop/error.hpp"
 #include "scallop/gouge.hpp"
 #include "scallop/raster.hpp"
 
-namespace scallop::cli {
+namespace scallop {
 namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
@@ -334,20 +332,4 @@ GcodeOptions defaultGcodeOptions(Units units, double partTop, const ToolPath& pa
 
 double defaultRapidRate(Units units) { return units == Units::inch ? 200.0 : 5000.0; }
 
-Vec3 parseNormal(const std::string& text) {
-  std::vector<std::string> parts;
-  std::stringstream stream(text);
-  for (std::string part; std::getline(stream, part, ',');) parts.push_back(part);
-  if (parts.size() != 3 || text.back() == ',')
-    throw Error(fmt::format("invalid normal '{}': expected X,Y,Z (three numbers) or auto", text));
-  const Vec3 n{parseFinite(parts[0], "normal x", "a number"),
-               parseFinite(parts[1], "normal y", "a number"),
-               parseFinite(parts[2], "normal z", "a number")};
-  if (n.x == 0.0 && n.y == 0.0 && n.z == 0.0)
-    throw Error(fmt::format("invalid normal '{}': the zero vector has no direction", text));
-  if (!std::isfinite(norm(n)))
-    throw Error(fmt::format("invalid normal '{}': too large", text));
-  return n;
-}
-
-}  // namespace scallop::cli
+}  // namespace scallop

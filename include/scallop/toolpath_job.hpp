@@ -15,7 +15,7 @@
 #include "scallop/surface.hpp"
 #include "scallop/toolpath.hpp"
 
-namespace scallop::cli {
+namespace scallop {
 
 struct JobOptions {
   std::string strategy = "contour";     ///< "contour" or "raster"
@@ -68,7 +68,4 @@ GcodeOptions defaultGcodeOptions(Units units, double partTop, const ToolPath& pa
 /// The rapid rate assumed for the cycle time when none is given: 200 in/min or 5000 mm/min.
 double defaultRapidRate(Units units);
 
-/// Parses "X,Y,Z" (three finite numbers, not all zero) for --normal.
-Vec3 parseNormal(const std::string& text);
-
-}  // namespace scallop::cli
+}  // namespace scallop
