@@ -16,6 +16,7 @@
 #include <fmt/format.h>
 
 #include "arguments.hpp"
+#include "scallop/cusp.hpp"
 #include "scallop/error.hpp"
 #include "scallop/mesh_drop.hpp"
 
@@ -30,14 +31,6 @@ double meshScale(const Mesh& mesh) {
 }
 
 }  // namespace
-
-double flatCusp(double radius, double spacing) {
-  if (!(spacing < 2.0 * radius))
-    throw Error(fmt::format("the spacing {} is not below the ball's diameter {}: neighbouring passes would leave "
-                            "uncut ridges of any height (give a spacing below 2 R, or --scallop-height)",
-                            spacing, 2.0 * radius));
-  return radius - std::sqrt(radius * radius - 0.25 * spacing * spacing);
-}
 
 MeshRasterResult runMeshRaster(const MeshJob& job, const MeshRasterRequest& request) {
   MeshRasterResult result;

@@ -64,10 +64,6 @@ struct MeshRasterResult {
 // The raster of `job` (refusals name request.source).
 MeshRasterResult runMeshRaster(const MeshJob& job, const MeshRasterRequest& request);
 
-// The cusp between balls of radius R on neighbouring passes `spacing` apart on a flat surface:
-// the scallop height a plan given --spacing is simulated against. Refused from 2 R up, where
-// the balls do not meet and nothing bounds what is left between passes.
-double flatCusp(double radius, double spacing);
 
 // A STEP or IGES part's tessellation as a mesh job; `exact`, when given, the faces that could
 // not be imported exactly (said on stderr); the deflection as given (empty: H / 8).

@@ -139,8 +139,8 @@ void runPaths(const PathsOptions& options) {
   const std::string strategy = options.strategy.empty() ? "contour" : options.strategy;
   if (strategy == "contour" && !options.angle.empty())
     throw CLI::ValidationError("paths", "--angle is for --strategy raster");
-  JobOptions job;
-  job.strategy = strategy;
+  ToolpathOptions job;
+  job.strategy = parseStrategy(strategy);
   job.toolRadius = parsePositive(options.toolRadius, "tool radius", "a positive length");
   if (!options.spacing.empty())
     job.spacing = parsePositive(options.spacing, "spacing", "a positive length");
@@ -156,10 +156,11 @@ void runPaths(const PathsOptions& options) {
 
   const Surface surface = loadSurface(options.surface, true, route.exact ? &*route.exact : nullptr);
   const std::string source = sourceName(options.surface);
+  job.source = source;
   const double rapidRate = options.rapidRate.empty()
                                ? defaultRapidRate(surface.units)
                                : parsePositive(options.rapidRate, "rapid rate", "a positive rate");
-  JobResult result = runToolpathJob(surface, source, job, std::nullopt, {});
+  ToolpathResult result = toolpaths(surface, job);
   const GcodeDialect dialect = gcodeDialect(options.dialect);
   const std::string title = fmt::format("scallop paths {} {}", strategy, source);
   const GcodeOptions gcodeOptions = defaultGcodeOptions(surface, result.path, dialect, title);

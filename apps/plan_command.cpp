@@ -42,7 +42,7 @@
 #include "surface_options.hpp"
 #include "linking_options.hpp"
 #include "mesh_job.hpp"
-#include "scallop/toolpath_job.hpp"
+#include "scallop/plan.hpp"
 
 namespace scallop::cli {
 namespace {
@@ -51,7 +51,7 @@ namespace {
 const OwnedNames kPlanOutputs = {"toolpath.ngc", "toolpath.gcode", "report.json",   "verify.svg",
                                  "paths.svg",    "paths-plan.svg", "gauss-map.svg", "stereographic.svg"};
 
-struct PlanOptions {
+struct PlanArguments {
   SurfaceSource surface;
   std::string strategy;  // empty: contour for a surface, raster for a mesh
   std::string toolRadius;
@@ -75,17 +75,6 @@ struct PlanOptions {
 // Rounds of rest finishing at most (each a simulation of the whole program more).
 constexpr int kRestRounds = 2;
 
-// report.json's `verification`: the simulated cut of the program in short.
-VerificationSummary verificationSummary(const SimulationReport& simulated, double stockAllowance) {
-  return VerificationSummary{simulated.design.spacing, simulated.heightErrorBound, stockAllowance,
-                             simulated.maxGouge, simulated.maxGougeAt, simulated.gougeArea,
-                             simulated.gougeTolerance, simulated.maxScallop, simulated.maxScallopAt,
-                             simulated.scallopP99, simulated.meanScallop, simulated.uncutArea,
-                             simulated.unreachableArea, simulated.maxUnreachableScallop,
-                             simulated.rapidsCutting, simulated.seconds, simulated.clearedGougePoints,
-                             simulated.maxClearedGouge};
-}
-
 // "; rest finishing: ..." when rest passes were added (what the strategies left, what it took).
 std::string restSummary(const PathsReport& report, Units units) {
   std::size_t passes = 0, targets = 0;
@@ -105,7 +94,7 @@ std::string restSummary(const PathsReport& report, Units units) {
 
 // The options a mesh plan (an STL mesh, a tessellated part: `what`) cannot honour, refused
 // by name before any work.
-void rejectMeshOptions(const PlanOptions& options, const char* what) {
+void rejectMeshOptions(const PlanArguments& options, const char* what) {
   const std::string path = sourceName(options.surface);
   const auto reject = [&](bool given, const char* option, const char* why) {
     if (given) throw Error(fmt::format("{}: {} {}; not for {}", path, option, why, what));
@@ -120,14 +109,14 @@ void rejectMeshOptions(const PlanOptions& options, const char* what) {
 }
 
 // What plan asks of a mesh raster.
-MeshRasterRequest meshRequest(const PlanOptions& options) {
+MeshRasterRequest meshRequest(const PlanArguments& options) {
   return {sourceName(options.surface), "plan", options.toolRadius, options.scallopHeight, options.spacing,
           options.quiet};
 }
 
 // `plan` on an STL mesh: raster passes of exact drop lines (mesh_raster.hpp), every move proven
 // within eps; the program written and its cut simulated on the mesh itself.
-void runPlanMesh(const PlanOptions& options, MeshJob job) {
+void runPlanMesh(const PlanArguments& options, MeshJob job) {
   const std::string path = sourceName(options.surface);  // "<stdin>" for "-"
   const char* const what = job.part ? "a tessellated part" : "a mesh";
   rejectMeshOptions(options, what);
@@ -274,7 +263,7 @@ void runPlanMesh(const PlanOptions& options, MeshJob job) {
              report.seconds, options.out);
 }
 
-void runPlan(const PlanOptions& options) {
+void runPlan(const PlanArguments& options) {
   if (!options.spacing.empty() && !options.scallopHeight.empty())
     throw CLI::ValidationError("plan", "give at most one of --spacing and --scallop-height");
   checkReplaceableDirectory(options.out, kPlanOutputs);  // before the work, not after it
@@ -306,113 +295,38 @@ void runPlan(const PlanOptions& options) {
   SurfaceSource from = options.surface;
   if (from.input.empty() && from.example.empty()) from.example = "paper-1";  // the main job
   const Surface surface = loadSurface(from, !options.quiet, route.exact ? &*route.exact : nullptr);
-  const std::string source = sourceName(from);
-  const bool inch = surface.units == Units::inch;
-  auto progress = [&](const std::string& line) {
-    if (!options.quiet) fmt::print(stderr, "scallop plan: {}...\n", line);
-  };
-
-  JobOptions job;
-  job.strategy = options.strategy.empty() ? "contour" : options.strategy;
-  // Defaults: a 1/2 inch (12 mm) ball-end mill and a finishing scallop of 0.001 in (0.025 mm).
-  job.toolRadius = options.toolRadius.empty()
-                       ? (inch ? 0.25 : 6.0)
-                       : parsePositive(options.toolRadius, "tool radius", "a positive length");
+  scallop::PlanOptions job;
+  job.source = sourceName(from);
+  job.strategy = parseStrategy(options.strategy.empty() ? "contour" : options.strategy);
+  if (!options.toolRadius.empty())
+    job.toolRadius = parsePositive(options.toolRadius, "tool radius", "a positive length");
   if (!options.spacing.empty()) {
     job.spacing = parsePositive(options.spacing, "spacing", "a positive length");
-    flatCusp(job.toolRadius, *job.spacing);  // refused early from 2 R up
-  } else {
-    job.scallopHeight = options.scallopHeight.empty()
-                            ? (inch ? 0.001 : 0.025)
-                            : parsePositive(options.scallopHeight, "scallop height", "a positive length");
+  } else if (!options.scallopHeight.empty()) {
+    job.scallopHeight = parsePositive(options.scallopHeight, "scallop height", "a positive length");
   }
   job.link = !options.noLinking;
   job.dropEnvelope = !options.noDropEnvelope;
   job.constantSpacing = options.constantSpacing;
-  job.linking.direction = options.oneWay ? PassDirection::keep : PassDirection::zigzag;
-  const double rapidRate = options.rapidRate.empty()
-                               ? defaultRapidRate(surface.units)
-                               : parsePositive(options.rapidRate, "rapid rate", "a positive rate");
-  progress("computing the optimal slicing orientation N* (Gauss map, medial axis, certificate)");
-  OptimalSlicing orientation = optimalSlicing(surface);
-  JobResult result = runToolpathJob(surface, source, job, orientation, progress);
-  PathsReport& report = result.report;
-  report.orientation = OrientationSummary{orientation.normal, orientation.alphaRad,
-                                          orientation.certified,
-                                          orientation.gaussMap.boundarySegments, orientation.seconds};
-
-  const GcodeDialect dialect = gcodeDialect(options.dialect);
-  const std::string title = fmt::format("scallop plan {} {}", job.strategy, source);
-  const std::string programName = dialect == GcodeDialect::grbl ? "toolpath.gcode" : "toolpath.ngc";
-  // The program as written, read back and cut in simulation (scallop verify): the finishing
-  // stock is the surface raised by half the links' clearance (what they assume roughing
-  // left; at least 2 H, so scallops up to 2 H show), the scallop height the one asked (or the
-  // flat-surface one of the spacing given).
-  SimulationOptions simulation;
-  simulation.toolRadius = job.toolRadius;
-  simulation.scallopHeight = job.scallopHeight ? *job.scallopHeight : flatCusp(job.toolRadius, report.spacing);
-  simulation.stockAllowance = std::max(report.linking ? 0.5 * report.linking->clearance : (inch ? 0.01 : 0.25),
-                                       2.0 * simulation.scallopHeight);
-  // The finishing stock is the surface raised by the allowance everywhere: a flat top at the
-  // part's highest point would clip it there (a flat part would show no scallop at all).
-  double top = -std::numeric_limits<double>::infinity();
-  for (const BezierPatch& patch : surface.patches)
-    for (const Vec3& c : patch.control) top = std::max(top, c.z);
-  simulation.stockTop = top + *simulation.stockAllowance;
-  GcodeOptions gcodeOptions;
-  std::string program;
-  const auto writeAndSimulate = [&] {
-    gcodeOptions = defaultGcodeOptions(surface, result.path, dialect, title);
-    program = gcodeProgram(result.path, gcodeOptions);
-    progress("simulating the cut of the program (scallop verify)");
-    return verifyProgram(surface, parseGcodeProgram(program, programName), simulation);
-  };
-  progress("writing the G-code");
-  SimulationReport simulated = writeAndSimulate();
-  // Rest finishing (rest_finishing.hpp): where the simulated cut leaves more than H on points
-  // the ball can reach (corners whose ball stands outside the footprint, rims of pockets
-  // tighter than the ball), passes through the balls that touch them, linked in with the
-  // others; the program is simulated again. Only when H was asked and the spacing is ours.
-  report.restFinishing = job.scallopHeight && !job.constantSpacing && !options.noRestFinishing;
-  for (int round = 0; report.restFinishing && round < kRestRounds; ++round) {
-    // The first round also serves what the grid may straddle beside the pockets
-    // (restTargets); a second one only what the grid still reads above H.
-    if (round > 0 ? simulated.uncutPoints == 0 : restTargets(simulated, *job.scallopHeight).empty()) break;
-    RestOptions rest;
-    rest.toolRadius = job.toolRadius;
-    rest.scallopHeight = *job.scallopHeight;
-    rest.sagTolerance = *job.scallopHeight / 4.0;
-    if (report.envelope) rest.depthTolerance = report.envelope->depthTolerance;
-    progress(fmt::format("rest finishing: {} grid points left above H", simulated.uncutPoints));
-    RestRound summary{simulated.maxScallop, simulated.uncutArea, {}};
-    RestPasses passes = restPasses(surface, simulated, rest);
-    summary.rest = passes.report;
-    report.restRounds.push_back(summary);
-    if (passes.path.passes.empty()) break;
-    addPasses(surface, source, job, passes.path, result, progress);
-    simulated = writeAndSimulate();
-  }
-
-  progress("writing the report and figures");
-  const std::string figureTitle = fmt::format(
-      "scallop plan: {} strategy on {}, R = {} {}, spacing {:.5g}, {} passes", job.strategy,
-      source, job.toolRadius, unitsName(surface.units), report.spacing, result.path.passes.size());
-  report.motion = gcodeMotion(result.path, gcodeOptions, rapidRate);
-  report.feedRate = gcodeOptions.feedRate;
-  report.plungeFeedRate = gcodeOptions.plungeFeedRate;
-  report.rapidRate = rapidRate;
-  report.verification = verificationSummary(simulated, *simulation.stockAllowance);
-  replaceDirectory(options.out,
-                   {
-                       {programName, program},
-                       {"report.json", pathsToJson(report, result.path)},
-                       {"verify.svg", verifySvg(simulated, {source, programName, 0, 0.0})},
-                       {"paths.svg", pathsSvg(surface, result.contactCurves, result.path, figureTitle, false)},
-                       {"paths-plan.svg", pathsSvg(surface, result.contactCurves, result.path, figureTitle, true)},
-                       {"gauss-map.svg", gaussMapSphereSvg(orientation)},
-                       {"stereographic.svg", stereographicSvg(orientation)},
-                   },
-                   kPlanOutputs);
+  job.oneWay = options.oneWay;
+  job.restFinishing = !options.noRestFinishing;
+  job.dialect = gcodeDialect(options.dialect);
+  if (!options.rapidRate.empty())
+    job.rapidRate = parsePositive(options.rapidRate, "rapid rate", "a positive rate");
+  JobControl control;
+  if (!options.quiet)
+    control.progress = [last = std::string()](double, const std::string& stage) mutable {
+      if (stage == last || stage == "done" || stage == "tool paths") return;  // a stage's advances; containers
+      last = stage;
+      fmt::print(stderr, "scallop plan: {}...\n", stage);
+    };
+  const PlanResult planned = plan(surface, job, control);
+  const PathsReport& report = planned.toolpaths.report;
+  const OptimalSlicing& orientation = planned.orientation;
+  const SimulationReport& simulated = planned.simulated;
+  const std::string& source = job.source;
+  if (!options.quiet) fmt::print(stderr, "scallop plan: writing the report and figures...\n");
+  replaceDirectory(options.out, planFiles(surface, planned), kPlanOutputs);
   const PathStats& s = report.stats;
   std::string gouge;
   if (report.envelope && report.envelope->verticesLifted > 0)
@@ -426,7 +340,7 @@ void runPlan(const PlanOptions& options) {
              "scallop plan: {} on {}: N* = ({:.4f}, {:.4f}, {:.4f}), alpha* = {:.3f} deg; spacing "
              "{:.5g}, {} planes, {} components, tool-centre length {:.4f} {}{}; {}; {:.2f} s -> "
              "{}/\n",
-             job.strategy, source, orientation.normal.x, orientation.normal.y,
+             report.strategy, source, orientation.normal.x, orientation.normal.y,
              orientation.normal.z, orientation.alphaRad * 180.0 / std::numbers::pi, report.spacing,
              s.planes, s.components, s.centreLength, unitsName(surface.units), gouge,
              cycleSummary(report, surface.units) +
@@ -445,7 +359,7 @@ void runPlan(const PlanOptions& options) {
 }  // namespace
 
 void addPlanCommand(CLI::App& app) {
-  auto options = std::make_shared<PlanOptions>();
+  auto options = std::make_shared<PlanArguments>();
   CLI::App* plan = app.add_subcommand(
       "plan", "The main job: surface -> optimal orientation -> tool paths -> G-code, report, figures");
   plan->footer(

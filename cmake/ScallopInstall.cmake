@@ -2,7 +2,8 @@
 #
 # Components: scallop_Development (static libraries, headers, the CMake package and
 # scallop.pc) and scallop_Runtime (the scallop program; shared libraries when
-# BUILD_SHARED_LIBS). Tests and benchmarks are not installed.
+# BUILD_SHARED_LIBS). Tests and benchmarks are not installed. The Python module's rule is in
+# python/CMakeLists.txt (component scallop_Python, SCALLOP_PYTHON_INSTALL_DIR).
 #
 # The CMake package: find_package(scallop) gives scallop::core, scallop::io, scallop::jobs
 # and scallop::scallop (all three); find_package(scallop COMPONENTS cad) adds scallop::cad (and finds

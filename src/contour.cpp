@@ -10,6 +10,7 @@
 
 #include "scallop/bezier.hpp"
 #include "scallop/error.hpp"
+#include "scallop/job_control.hpp"
 #include "scallop/gouge.hpp"
 #include "scallop/optimal_slicing.hpp"
 #include "alignment.hpp"
@@ -161,6 +162,8 @@ ContourPaths contourPaths(const Surface& surface, const ContourOptions& options)
   std::optional<SurfaceDistance> distance;
   if (options.dropEnvelope) distance.emplace(surface);
   for (double kk = range.first; kk <= range.last; kk += 1.0) {
+    // The sections take about half of the stage, the lift to the envelope the rest.
+    advanceStage(static_cast<std::size_t>(kk - range.first), 2 * static_cast<std::size_t>(range.last - range.first + 1));
     const long long k = static_cast<long long>(kk);
     const double offset = offsetAt(kk);
     // The pass's band, half way to the neighbouring planes, for its run-on (envelope.hpp).
@@ -214,6 +217,7 @@ ContourPaths contourPaths(const Surface& surface, const ContourOptions& options)
     envelope.depthTolerance = options.depthTolerance;
     envelope.stretchThreshold = options.stretchThreshold;
     envelope.sagTolerance = options.sagTolerance;
+    const ProgressStage lifting(0.5, 1.0);  // the second half of the caller's stage
     out.path = liftToDropEnvelope(*distance, out.path, envelope, out.envelope);
     out.stats.centreLength = 0.0;
     for (const ToolPass& pass : out.path.passes) {

@@ -10,6 +10,7 @@
 #include "scallop/bezier.hpp"
 #include "scallop/contour.hpp"
 #include "scallop/error.hpp"
+#include "scallop/job_control.hpp"
 
 namespace scallop {
 namespace {
@@ -167,7 +168,8 @@ CentreSamples centreSamples(const Surface& surface, const Vec3& m, double radius
     }
     const double size = norm(hi - lo);
     const int grid = static_cast<int>(std::clamp(std::ceil(2.0 * size / flatStep), 16.0, 128.0));
-    for (int i = 0; i <= grid; ++i)
+    for (int i = 0; i <= grid; ++i) {
+      checkCancelled();
       for (int j = 0; j <= grid; ++j) {
         const double u = double(i) / grid, v = double(j) / grid;
         if (!surfaceKeepsPoint(surface, p, u, v)) continue;
@@ -183,6 +185,7 @@ CentreSamples centreSamples(const Surface& surface, const Vec3& m, double radius
         g.kappa = std::isfinite(kappa) ? kappa : -2.0 / radius;
         out.samples.push_back({dot(m, q + radius * n), g});
       }
+    }
   }
   std::sort(out.samples.begin(), out.samples.end(),
             [](const CentreSample& a, const CentreSample& b) { return a.w < b.w; });
@@ -405,12 +408,16 @@ AdaptiveOffsets adaptivePlaneOffsets(const Surface& surface, const Vec3& unitNor
                             height, out.floor, (extent.hi - extent.lo) / out.floor));
 
   const auto sectionAt = [&](double w) {
+    // Progress by the plane's place across the surface (polls the job's cancellation too).
+    advanceStage(static_cast<std::size_t>(std::clamp((w - extent.lo) / (extent.hi - extent.lo), 0.0, 1.0) * 1000.0),
+                 1000);
     ++out.sections;
     return planeSection(surface, unitNormal, w, tolerance);
   };
   // The pair (w, w + delta)'s worst cusp; the contacts of w + delta are returned for reuse.
   const auto worst = [&](const std::vector<CrossGeometry>& here, double w, double delta,
                          std::vector<CrossGeometry>& next) {
+    checkCancelled();
     if (options.centrePlanes) return std::max(0.0, centres.worst(w, delta, radius));
     double h = 0.0;
     for (const CrossGeometry& g : here) h = std::max(h, sampleCusp(g, delta, radius, false, nullptr));
@@ -471,6 +478,14 @@ AdaptiveOffsets adaptivePlaneOffsets(const Surface& surface, const Vec3& unitNor
     out.offsets.push_back(w + step);
   }
   return out;
+}
+
+double flatCusp(double radius, double spacing) {
+  if (!(spacing < 2.0 * radius))
+    throw Error(fmt::format("the spacing {} is not below the ball's diameter {}: neighbouring passes would leave "
+                            "uncut ridges of any height (give a spacing below 2 R, or --scallop-height)",
+                            spacing, 2.0 * radius));
+  return radius - std::sqrt(radius * radius - 0.25 * spacing * spacing);
 }
 
 }  // namespace scallop

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <exception>
 #include <functional>
 #include <memory>
 #include <limits>
@@ -21,6 +22,7 @@
 #include "scallop/bezier.hpp"
 #include "scallop/envelope.hpp"
 #include "scallop/error.hpp"
+#include "scallop/job_control.hpp"
 #include "scallop/gouge.hpp"
 #include "scallop/mesh.hpp"
 #include "scallop/mesh_drop.hpp"
@@ -342,6 +344,7 @@ struct DesignPatch {
 
 void designCell(const DesignPatch& design, double u0, double u1, double v0, double v1, int depth, HeightGrid& grid,
                 std::vector<double>* normalZ) {
+  checkCancelled();
   const BezierPatch& patch = design.patch;
   // A trimmed patch's cell outside its face holds no design; inside it, no hit needs a test.
   DesignPatch inner = design;
@@ -570,6 +573,7 @@ void designHeights(const Surface& surface, HeightGrid& grid, std::vector<double>
   if (normalZ) normalZ->assign(grid.z.size(), 0.0);
   const double tolerance = 1e-12 * std::max(surfaceScale(surface), 1e-300);
   for (std::size_t i = 0; i < surface.patches.size(); ++i) {
+    advanceStage(i, 3 * surface.patches.size());  // the design: about a third of a simulation
     designCell(DesignPatch{surface.patches[i], jacobianSign(surface.patches[i]), tolerance, patchTrim(surface, i)}, 0.0,
                1.0, 0.0, 1.0, 0, grid, normalZ);
   }
@@ -587,6 +591,7 @@ void meshDesign(const Mesh& mesh, HeightGrid& grid, std::vector<double>* normalZ
   if (normalZ) normalZ->assign(grid.z.size(), 0.0);
   if (triangles) triangles->assign(grid.z.size(), kNoTriangle);
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    if (t % 256 == 0) checkCancelled();
     const auto& tri = mesh.triangles[t];
     const Vec3 a = mesh.vertices[tri[0]], b = mesh.vertices[tri[1]], c = mesh.vertices[tri[2]];
     const Vec3 n = cross(b - a, c - a);
@@ -664,6 +669,7 @@ std::size_t sweepMoves(const std::vector<SweptMove>& moves, double toolRadius, H
   if (lowestMove) lowestMove->assign(stock.z.size(), kNoMove);
   std::size_t visits = 0;
   for (std::size_t m = 0; m < moves.size(); ++m) {
+    advanceStage(moves.size() + 2 * m, 3 * moves.size());  // the sweep: the rest of a simulation
     requireMoveFinite(moves[m], m);
     const MoveShape shape(moves[m], toolRadius);
     const auto [is, js] = pointsNear(shape, toolRadius, stock);
@@ -703,13 +709,32 @@ using ReachPreparation = std::function<std::function<ReachTest()>()>;
 using ClearanceTest = std::function<bool(Vec3)>;
 using ClearancePreparation = std::function<std::function<ClearanceTest()>()>;
 
-// Runs work(from, to) over [0, count) on up to every core, in blocks of at least 256.
+// Runs work(from, to) over [0, count) on up to every core, in blocks of at least 256, the
+// job's control installed on every thread (work polls it); an error (Cancelled among them)
+// is rethrown on the calling thread, the first block's first.
 void onEveryCore(std::size_t count, const std::function<void(std::size_t, std::size_t)>& work) {
   const std::size_t threads =
       std::clamp<std::size_t>(threadCount(), 1, std::max<std::size_t>(1, count / 256));
-  std::vector<std::jthread> pool;
-  for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(work, count * t / threads, count * (t + 1) / threads);
-  work(0, count / threads);
+  std::vector<std::exception_ptr> errors(threads);
+  const auto block = [&](std::size_t t) {
+    try {
+      work(count * t / threads, count * (t + 1) / threads);
+    } catch (...) {
+      errors[t] = std::current_exception();
+    }
+  };
+  {
+    std::vector<std::jthread> pool;
+    const JobControl* const control = currentJobControl();
+    for (std::size_t t = 1; t < threads; ++t)
+      pool.emplace_back([&block, control, t] {
+        const JobControlScope scope(control, false);
+        block(t);
+      });
+    block(0);
+  }
+  for (const std::exception_ptr& error : errors)
+    if (error) std::rethrow_exception(error);
 }
 
 // The contract's Reach on a mesh: q's upward normal is that of the triangle that holds q over
@@ -895,6 +920,7 @@ void sweepAndCompare(SimulationReport& report, const std::vector<SweptMove>& mov
       onEveryCore(checks, [&](std::size_t from, std::size_t to) {
         const ClearanceTest clear = clearanceTest();
         for (std::size_t k = from; k < to; ++k) {
+          checkCancelled();
           const std::size_t index = deep[k];
           const Vec2 p = design.point(index % design.columns, index / design.columns);
           const std::optional<Vec3> centre =
@@ -938,6 +964,7 @@ void sweepAndCompare(SimulationReport& report, const std::vector<SweptMove>& mov
     onEveryCore(checks, [&](std::size_t from, std::size_t to) {
       const ReachTest beyondReach = reachTest();
       for (std::size_t k = from; k < to; ++k) {
+        checkCancelled();
         const std::size_t index = uncut[k];
         const Vec2 p = design.point(index % design.columns, index / design.columns);
         if (beyondReach(Vec3{p.x, p.y, design.z[index]})) report.unreachable[index] = 1;

@@ -13,6 +13,7 @@
 
 #include "scallop/bezier.hpp"
 #include "scallop/error.hpp"
+#include "scallop/job_control.hpp"
 #include "scallop/parallel.hpp"
 #include "scallop/surface.hpp"
 
@@ -316,6 +317,7 @@ PassLift liftPass(const SurfaceDistance& distance, const ToolPass& pass, std::si
     sagLast = std::min(options.sagMoves[passIndex].second, pass.moves.size());
   }
   for (std::size_t m = 0; m < pass.moves.size(); ++m) {
+    checkCancelled();
     sagHere = options.sagTolerance > 0.0 && m >= sagFirst && m < sagLast;
     const ToolMove& move = pass.moves[m];
     if (!isFinite(move.end) || (move.kind == MoveKind::arc && !isFinite(move.center))) {
@@ -412,6 +414,7 @@ ToolPath liftToDropEnvelope(const SurfaceDistance& distance, const ToolPath& pat
   const auto work = [&] {
     for (std::size_t i = nextPass++; i < path.passes.size(); i = nextPass++) {
       try {
+        advanceStage(i, path.passes.size());  // reports on the calling thread only
         lifts[i] = liftPass(distance, path.passes[i], i, radius, eps, top, options);
       } catch (...) {
         errors[i] = std::current_exception();
@@ -422,7 +425,12 @@ ToolPath liftToDropEnvelope(const SurfaceDistance& distance, const ToolPath& pat
       path.passes.size(), threadCount(options.threads));
   {
     std::vector<std::jthread> pool;
-    for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(work);
+    const JobControl* const control = currentJobControl();
+    for (std::size_t t = 1; t < threads; ++t)
+      pool.emplace_back([&work, control] {
+        const JobControlScope scope(control, false);
+        work();
+      });
     work();
   }
   for (const std::exception_ptr& error : errors) {
@@ -606,6 +614,7 @@ std::vector<Vec3> runOnPastEnd(const SurfaceDistance& distance, Vec3 end, Vec3 d
   std::size_t keep = 0;  // up to the last vertex inside the band
   const auto steps = static_cast<std::size_t>(std::floor(length / step));
   for (std::size_t k = 1; k <= steps; ++k) {
+    checkCancelled();
     const double along = static_cast<double>(k) * step;
     const BandDropper::Dropped c = dropper.drop(end.x + along * h.x, end.y + along * h.y);
     if (c.verdict == BandDropper::Verdict::clear) break;
@@ -646,6 +655,7 @@ std::vector<std::vector<Vec3>> dropLineRuns(const SurfaceDistance& distance, Vec
   std::vector<Vec3> run;
   const auto steps = static_cast<std::size_t>(std::floor((to - from) / step));
   for (std::size_t k = 0; k <= steps; ++k) {
+    checkCancelled();
     const double t = from + static_cast<double>(k) * step;
     const BandDropper::Dropped c = dropper.drop(origin.x + t * h.x, origin.y + t * h.y);
     if (c.verdict == BandDropper::Verdict::inside) {

@@ -21,6 +21,7 @@
 #include "scallop/bernstein.hpp"
 #include "scallop/bezier.hpp"
 #include "scallop/error.hpp"
+#include "scallop/job_control.hpp"
 
 namespace scallop {
 namespace {
@@ -567,6 +568,7 @@ struct CellBuilder {
 
   void visit(const Bernstein2& k, double u0, double u1, double v0, double v1, int depth,
              const NormalGrid& grid) {
+    checkCancelled();
     const Vec3& centre = grid[1][1];
     double spread = 0.0;
     for (int i = 0; i <= 2; ++i) {
@@ -1263,6 +1265,8 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
   auto inPatch = [](const PatchData& data, const auto& work) {
     try {
       work();
+    } catch (const Cancelled&) {
+      throw;
     } catch (const Error& e) {
       throw Error(fmt::format("patches[{}]: {}", data.index, e.what()));
     }

@@ -25,6 +25,7 @@
 #include <fmt/format.h>
 
 #include "scallop/error.hpp"
+#include "scallop/job_control.hpp"
 #include "scallop/parallel.hpp"
 
 namespace scallop {
@@ -1565,6 +1566,7 @@ GougeReport gougeCheck(const SurfaceDistance& distance, const ToolPath& path, do
     Block& block = blocks[b];
     for (std::size_t k = blockStarts[b]; k < blockStarts[b + 1]; ++k) {
       const Segment& s = segments[k];
+      checkCancelled();
       for (std::size_t i = s.sampleStart ? 0 : 1; i <= s.steps; ++i) {
         const Vec3 center = positionOn(s, i);
         // A sample farther than both the least distance so far and R - threshold changes
@@ -1597,6 +1599,7 @@ GougeReport gougeCheck(const SurfaceDistance& distance, const ToolPath& path, do
     const auto run = [&](std::size_t first) {
       for (std::size_t b = first; b < blocks.size(); b += threads) {
         try {
+          advanceStage(b, blocks.size());  // reports on the calling thread only
           sampleBlock(b);
         } catch (...) {
           errors[b] = std::current_exception();
@@ -1604,7 +1607,12 @@ GougeReport gougeCheck(const SurfaceDistance& distance, const ToolPath& path, do
       }
     };
     std::vector<std::jthread> pool;
-    for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(run, t);
+    const JobControl* const control = currentJobControl();
+    for (std::size_t t = 1; t < threads; ++t)
+      pool.emplace_back([&run, control, t] {
+        const JobControlScope scope(control, false);
+        run(t);
+      });
     run(0);
   }
   for (const std::exception_ptr& error : errors) {

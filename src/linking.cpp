@@ -12,6 +12,7 @@
 
 #include "scallop/envelope.hpp"
 #include "scallop/error.hpp"
+#include "scallop/job_control.hpp"
 #include "scallop/gouge.hpp"
 #include "clearance.hpp"
 
@@ -132,6 +133,7 @@ LinkedPath linkToolPath(const Surface& surface, const ToolPath& path, const Link
     used[0] = true;
     Vec3 at = passEnd(path.passes[units[0].first + units[0].count - 1]);
     for (std::size_t step = 1; step < units.size(); ++step) {
+      checkCancelled();
       Entry best;
       for (std::size_t u = 0; u < units.size(); ++u) {
         if (used[u]) continue;
@@ -219,6 +221,8 @@ LinkedPath linkToolPath(const Surface& surface, const ToolPath& path, const Link
     ToolPath lifted;
     try {
       lifted = liftToDropEnvelope(distance, link, envelope, report);
+    } catch (const Cancelled&) {
+      throw;
     } catch (const Error&) {
       return std::nullopt;  // over its budget: a retract instead
     }
@@ -230,6 +234,7 @@ LinkedPath linkToolPath(const Surface& surface, const ToolPath& path, const Link
   std::vector<ToolPass>& passes = out.path.passes;
   out.linkMoves.assign(passes.size(), 0);
   for (std::size_t i = 0; i < passes.size(); ++i) {
+    checkCancelled();
     ToolPass& pass = passes[i];
     if (i > 0 && !pass.retractBefore) continue;  // the strategy's own link
     const Vec3 s = pass.start;

@@ -22,6 +22,7 @@
 #include "scallop/bernstein.hpp"
 #include "scallop/bezier.hpp"
 #include "scallop/error.hpp"
+#include "scallop/job_control.hpp"
 #include "scallop/medial_axis.hpp"
 #include "scallop/vector.hpp"
 
@@ -707,6 +708,7 @@ Vec3 polishDirection(const ContactFinder& finder, Vec3 n, double initialRadius, 
   if (contacts.empty()) return n;
   double radius = initialRadius;
   for (int iteration = 0; iteration < 200 && radius > 1e-12; ++iteration) {
+    checkCancelled();
     const Vec3 e1 = orthogonal(n);
     const Vec3 e2 = cross(n, e1);
     // Contacts the step can make the top: a contact falls at most |g| |d| <= sqrt(2) radius
@@ -768,6 +770,7 @@ Vec3 polishDirection(const ContactFinder& finder, Vec3 n, double initialRadius, 
 // Proves P = cos^2(bound) |N|^2 - (N . m)^2 > 0 on the cell (P given in Bernstein form on
 // it): then |n . m| < cos(bound), no normal within `bound` of +-m.
 bool provePositive(const Bernstein2& p, int depth, int maxDepth, std::size_t& cells) {
+  if (cells % 64 == 0) checkCancelled();
   ++cells;
   const Bounds b = bounds(p);
   if (b.lo > 0.0) return true;
@@ -907,6 +910,7 @@ AxisCandidates rateCandidates(const MedialAxis& axis, double windowRad) {
   AxisCandidates out;
   out.edgeBestAlpha.assign(axis.edges.size(), -1.0);
   for (std::size_t e = 0; e < axis.edges.size(); ++e) {
+    if (e % 256 == 0) checkCancelled();
     const MedialEdge& edge = axis.edges[e];
     std::vector<double> ts;
     const double bound = bestEnd >= 0.0 ? alphaBound(edge) : std::numbers::pi;
@@ -1357,6 +1361,8 @@ BestCircles bestCircles(const PlanarDomain& domain, const BestCirclesOptions& op
       MedialAxis axis;
       try {
         axis = medialAxis(mixed);
+      } catch (const Cancelled&) {
+        throw;
       } catch (const Error&) {
         break;  // the simplified loops cross where the domain is thinner than delta
       }
@@ -1423,6 +1429,8 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
       if (domain.loops.empty()) break;
       try {
         found = bestCircles(domain, searchOptions);
+      } catch (const Cancelled&) {
+        throw;
       } catch (const Error&) {
         if (attempt == 1 && cleaned == 1) throw;
       }

@@ -10,6 +10,7 @@
 
 #include "scallop/bezier.hpp"
 #include "scallop/error.hpp"
+#include "scallop/job_control.hpp"
 #include "scallop/gouge.hpp"
 #include "scallop/path_sampling.hpp"
 #include "alignment.hpp"
@@ -430,6 +431,7 @@ std::pair<double, double> goldenMaximum(const F& f, double lo, double hi, double
   double x1 = hi - ratio * (hi - lo), x2 = lo + ratio * (hi - lo);
   double f1 = f(x1), f2 = f(x2);
   while (hi - lo > tolerance) {
+    checkCancelled();
     if (f1 >= f2) {
       hi = x2, x2 = x1, f2 = f1;
       x1 = hi - ratio * (hi - lo), f1 = f(x1);
@@ -450,8 +452,10 @@ double bestRasterAngle(const Surface& surface) {
   // best few local maxima of the estimate, cyclically.
   std::vector<double> scan(kAngleScan);
   const double step = kPi / kAngleScan;
-  for (int i = 0; i < kAngleScan; ++i)
+  for (int i = 0; i < kAngleScan; ++i) {
+    checkCancelled();
     scan[static_cast<std::size_t>(i)] = objective.estimate(i * step);
+  }
   std::vector<std::pair<double, int>> peaks;
   for (int i = 0; i < kAngleScan; ++i) {
     const double here = scan[static_cast<std::size_t>(i)];
@@ -593,6 +597,7 @@ RasterPaths rasterPaths(const Surface& surface, const RasterOptions& options) {
     bool visible = false;
   };
   const auto buildPlane = [&](double w, long long k, const RunOnBand& band, double step, bool dropLine) {
+    checkCancelled();
     PlaneBuild b;
     PlaneSection section = planeSection(surface, frame.e, w, tolerance);
     out.stats.touchPoints += section.touchPoints.size();
@@ -602,6 +607,8 @@ RasterPaths rasterPaths(const Surface& surface, const RasterOptions& options) {
       // Not a graph here: the part a ball from above sees (the error names where otherwise).
       try {
         b.plane.chains = planeChains(section, frame, w, radius, tau);
+      } catch (const Cancelled&) {
+        throw;
       } catch (const Error&) {
         b.plane.chains = visibleChains(section, frame, radius);
         b.visible = true;
@@ -733,6 +740,7 @@ RasterPaths rasterPaths(const Surface& surface, const RasterOptions& options) {
   for (auto b = below.rbegin(); b != below.rend(); ++b) appendPlane(std::move(*b));
   for (double kk = range.first; kk <= range.last; kk += 1.0) {
     const std::size_t at = below.size() + static_cast<std::size_t>(kk - range.first);
+    advanceStage(at, allOffsets.size());
     const double w = allOffsets[at];
     RunOnBand band{frame.e, radius};
     double gap = 4.0 * radius;

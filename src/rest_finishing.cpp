@@ -10,6 +10,7 @@
 
 #include "scallop/bezier.hpp"
 #include "scallop/error.hpp"
+#include "scallop/job_control.hpp"
 #include "scallop/gouge.hpp"
 
 namespace scallop {
@@ -201,6 +202,7 @@ RestPasses restPasses(const Surface& surface, const SimulationReport& simulated,
   DropCutter cutter(distance, radius, lifting);
   std::vector<Vec3> witnesses;
   for (const std::size_t index : targets) {
+    checkCancelled();
     const Vec2 p = design.point(index % design.columns, index / design.columns);
     const Vec3 q{p.x, p.y, design.z[index]};
     const ReachWitness witness = reachWitness(distance, cutter, q, radius);
@@ -272,6 +274,7 @@ RestPasses meshRestPasses(const Mesh& mesh, const MeshDropCutter& cutter, const 
   report.passes = chains.passes.size();
   // Every step an exact drop line: the ball's centre on the proven envelope between witnesses.
   for (const ToolPass& chain : chains.passes) {
+    checkCancelled();
     ToolPass pass;
     pass.retractBefore = true;
     const DropLine first = cutter.dropLine({chain.start.x, chain.start.y}, {1.0, 0.0}, 0.0, 0.0, dropLine);

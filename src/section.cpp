@@ -12,6 +12,7 @@
 #include "scallop/bernstein.hpp"
 #include "scallop/bezier.hpp"
 #include "scallop/error.hpp"
+#include "scallop/job_control.hpp"
 
 namespace scallop {
 namespace {
@@ -271,6 +272,7 @@ void sectionPatch(PatchSection& section, double tolerance, std::vector<Piece>& p
   }
   std::vector<Cell> stack{{0.0, 1.0, 0.0, 1.0, 0}};
   while (!stack.empty()) {
+    if (cells % 64 == 0) checkCancelled();
     const Cell cell = stack.back();
     stack.pop_back();
     ++cells;
@@ -415,6 +417,7 @@ void joinPieces(std::vector<Piece> pieces, double joinTolerance, double chordalT
             [&](std::size_t a, std::size_t b) { return endPoint(a).x < endPoint(b).x; });
   DisjointSets ends(2 * count);
   for (std::size_t i = 0; i < order.size(); ++i) {
+    if (i % 256 == 0) checkCancelled();
     for (std::size_t j = i + 1; j < order.size(); ++j) {
       if (endPoint(order[j]).x - endPoint(order[i]).x > std::max(joinTolerance, widest)) break;
       // A seam lies between two patches: ends on one patch meet exactly or not at all.
@@ -494,6 +497,7 @@ PlaneSection planeSection(const Surface& surface, const Vec3& normal, double off
   PlaneSection out;
   std::vector<Piece> pieces;
   for (std::size_t i = 0; i < surface.patches.size(); ++i) {
+    checkCancelled();
     PatchSection section(surface.patches[i], i, n, d);
     const PatchTrim* trim = patchTrim(surface, i);
     if (trim == nullptr) {

@@ -19,9 +19,8 @@ namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
 
-void say(const Progress& progress, const std::string& line) {
-  if (progress) progress(line);
-}
+// The stages of toolpaths, as parts of its [0, 1] (by their share of paper-1's plan time).
+constexpr double kOrientEnd = 0.02, kOffsetsEnd = 0.40, kPathsEnd = 0.85, kLinkEnd = 0.88;
 
 std::vector<Vec3> curvePoints(const SectionCurve& curve) {
   std::vector<Vec3> points;
@@ -32,10 +31,10 @@ std::vector<Vec3> curvePoints(const SectionCurve& curve) {
 
 // The ball against the whole surface, sampled every R / 10 along the path (the bound
 // between samples adds R / 20): an independent measure beside the envelope's proof.
-void checkGouge(const Surface& surface, const JobOptions& options, JobResult& result,
-                const Progress& progress) {
+void checkGouge(const Surface& surface, const ToolpathOptions& options, ToolpathResult& result) {
   const double spacing = options.toolRadius / 10.0;
-  say(progress, fmt::format("checking the ball against the whole surface every {:.6g}", spacing));
+  const ProgressStage stage(kLinkEnd, 1.0,
+                            fmt::format("checking the ball against the whole surface every {:.6g}", spacing));
   result.report.gouge = gougeCheck(surface, result.path, spacing);
   result.report.gougeSampleSpacing = spacing;
 }
@@ -51,8 +50,8 @@ struct ScallopPlanes {
   std::size_t floorSteps = 0;
 };
 
-ScallopPlanes scallopPlanes(const Surface& surface, const JobOptions& options, const Vec3& normal,
-                            bool centrePlanes, const Progress& progress) {
+ScallopPlanes scallopPlanes(const Surface& surface, const ToolpathOptions& options, const Vec3& normal,
+                            bool centrePlanes) {
   ScallopPlanes out;
   if (!options.scallopHeight || options.constantSpacing) return out;
   out.chordalTolerance =
@@ -65,14 +64,15 @@ ScallopPlanes scallopPlanes(const Surface& surface, const JobOptions& options, c
   cusp.scallopHeight = *options.scallopHeight - out.chordalTolerance;
   cusp.chordalTolerance = out.chordalTolerance;
   cusp.centrePlanes = centrePlanes;
-  say(progress, "choosing plane offsets that keep the cusp below the scallop height on the curved surface");
+  const ProgressStage stage(kOrientEnd, kOffsetsEnd,
+                            "choosing plane offsets that keep the cusp below the scallop height on the curved surface");
   AdaptiveOffsets adaptive = adaptivePlaneOffsets(surface, normal, cusp);
   out.offsets = std::move(adaptive.offsets);
   out.floorSteps = adaptive.floorSteps;
   return out;
 }
 
-ScallopReport scallopReport(const Surface& surface, const JobOptions& options, const Vec3& normal,
+ScallopReport scallopReport(const Surface& surface, const ToolpathOptions& options, const Vec3& normal,
                             double flatSpacing, const ScallopPlanes& planes,
                             const std::vector<PlaneContacts>& used, bool centrePlanes) {
   ScallopReport report;
@@ -101,17 +101,16 @@ ScallopReport scallopReport(const Surface& surface, const JobOptions& options, c
   return report;
 }
 
-void runContour(const Surface& surface, const JobOptions& options, JobResult& result,
-                const Progress& progress) {
+void runContour(const Surface& surface, const ToolpathOptions& options, ToolpathResult& result) {
   Vec3 normal;
   double alpha = 0.0;
   if (options.normal) {
     normal = normalized(*options.normal);
-    say(progress, "bounding the angle between the planes and the surface normals");
+    const ProgressStage stage(0.0, kOrientEnd, "bounding the angle between the planes and the surface normals");
     alpha = minimumAngleBound(surface, normal);
   } else {
     if (!result.orientation) {
-      say(progress, "computing the optimal slicing orientation N*");
+      const ProgressStage stage(0.0, kOrientEnd, "computing the optimal slicing orientation N*");
       result.orientation = optimalSlicing(surface);
     }
     normal = result.orientation->normal;
@@ -144,13 +143,15 @@ void runContour(const Surface& surface, const JobOptions& options, JobResult& re
   contour.spacing = options.spacing ? *options.spacing
                                     : spacingForScallopHeight(options.toolRadius,
                                                               *options.scallopHeight, alpha);
-  const ScallopPlanes planes = scallopPlanes(surface, options, normal, false, progress);
+  const ScallopPlanes planes = scallopPlanes(surface, options, normal, false);
   contour.planeOffsets = planes.offsets;
   contour.chordalTolerance = planes.chordalTolerance;
-  say(progress, planes.offsets.empty()
-                    ? fmt::format("cutting the surface with planes {:.6g} apart", contour.spacing)
-                    : fmt::format("cutting the surface with {} planes", planes.offsets.size()));
+  std::optional<ProgressStage> stage;
+  stage.emplace(kOffsetsEnd, kPathsEnd,
+                planes.offsets.empty() ? fmt::format("cutting the surface with planes {:.6g} apart", contour.spacing)
+                                       : fmt::format("cutting the surface with {} planes", planes.offsets.size()));
   ContourPaths paths = contourPaths(surface, contour);
+  stage.reset();
   if (options.scallopHeight) {
     std::vector<PlaneContacts> used;
     for (const ContourSection& section : paths.sections) used.push_back({section.offset, &section.section});
@@ -167,8 +168,7 @@ void runContour(const Surface& surface, const JobOptions& options, JobResult& re
   result.path = std::move(paths.path);
 }
 
-void runRaster(const Surface& surface, const JobOptions& options, JobResult& result,
-               const Progress& progress) {
+void runRaster(const Surface& surface, const ToolpathOptions& options, ToolpathResult& result) {
   RasterOptions raster;
   raster.toolRadius = options.toolRadius;
   if (options.scallopHeight) raster.stretchThreshold = *options.scallopHeight;
@@ -179,23 +179,27 @@ void runRaster(const Surface& surface, const JobOptions& options, JobResult& res
     raster.angleRad = *options.angleDeg * kDeg;
   } else if (adaptive) {
     // The planes' normal is needed before the paths: the same search rasterPaths would run.
-    say(progress, "searching the feed direction with the widest step-over");
+    const ProgressStage stage(0.0, kOrientEnd, "searching the feed direction with the widest step-over");
     raster.angleRad = bestRasterAngle(surface);
   } else {
     raster.bestAngle = true;
-    say(progress, "searching the feed direction with the widest step-over");
   }
   if (options.spacing) raster.spacing = *options.spacing;
   if (options.scallopHeight) raster.scallopHeight = *options.scallopHeight;
   ScallopPlanes planes;
   if (adaptive) {
     const Vec3 e{-std::sin(raster.angleRad), std::cos(raster.angleRad), 0.0};
-    planes = scallopPlanes(surface, options, e, true, progress);
+    planes = scallopPlanes(surface, options, e, true);
     raster.planeOffsets = planes.offsets;
     raster.chordalTolerance = planes.chordalTolerance;
   }
-  say(progress, "cutting the surface with vertical planes; scallop hull of each section");
+  std::optional<ProgressStage> stage;
+  stage.emplace(kOffsetsEnd, kPathsEnd,
+                raster.bestAngle ? "searching the feed direction with the widest step-over; cutting the surface with "
+                                   "vertical planes; scallop hull of each section"
+                                 : "cutting the surface with vertical planes; scallop hull of each section");
   RasterPaths paths = rasterPaths(surface, raster);
+  stage.reset();
   if (options.scallopHeight) {
     std::vector<PlaneContacts> used;
     for (const RasterSection& section : paths.sections) used.push_back({section.offset, &section.section});
@@ -218,11 +222,11 @@ void runRaster(const Surface& surface, const JobOptions& options, JobResult& res
 // Linking (linking.hpp): the finished path's passes ordered, and needless retracts to the
 // safe height replaced by proven direct feeds and local retracts; then the gouge check on the
 // path as it will be cut, links included.
-void linkAndCheck(const Surface& surface, const std::string& source, const JobOptions& options,
-                  JobResult& result, const Progress& progress) {
+void linkAndCheck(const Surface& surface, const ToolpathOptions& options, ToolpathResult& result) {
+  const std::string& source = options.source;
   result.path = result.unlinkedPath;
   if (options.link) {
-    say(progress, "ordering and linking the passes");
+    const ProgressStage stage(kPathsEnd, kLinkEnd, "ordering and linking the passes");
     try {
       // The links' margin and their plunges at feed must exceed the stock left above the
       // surface: the cusps, up to the scallop height H (more at the boundary), so at least 4 H.
@@ -236,19 +240,27 @@ void linkAndCheck(const Surface& surface, const std::string& source, const JobOp
       result.path = std::move(linked.path);
       result.report.linking = linked.stats;
       result.report.linkMoves = std::move(linked.linkMoves);
+    } catch (const Cancelled&) {
+      throw;
     } catch (const Error& error) {
       throw Error(fmt::format("{}: {}", source, error.what()));
     }
   }
-  if (options.gougeCheck) checkGouge(surface, options, result, progress);
+  if (options.gougeCheck) checkGouge(surface, options, result);
 }
 
 }  // namespace
 
-JobResult runToolpathJob(const Surface& surface, const std::string& source,
-                         const JobOptions& options, std::optional<OptimalSlicing> orientation,
-                         const Progress& progress) {
-  const auto start = std::chrono::steady_clock::now();
+const char* strategyName(Strategy strategy) { return strategy == Strategy::raster ? "raster" : "contour"; }
+
+Strategy parseStrategy(const std::string& text) {
+  if (text == "contour") return Strategy::contour;
+  if (text == "raster") return Strategy::raster;
+  throw Error(fmt::format("unknown strategy '{}': expected contour or raster", text));
+}
+
+void validateToolpathOptions(const Surface& surface, const ToolpathOptions& options) {
+  const std::string& source = options.source;
   if (!(options.toolRadius > 0.0) || !std::isfinite(options.toolRadius))
     throw Error(fmt::format("the tool radius must be positive, got {}", options.toolRadius));
   // A ball a thousand times the size of the part is a typo (mm for inches, a missing
@@ -263,38 +275,46 @@ JobResult runToolpathJob(const Surface& surface, const std::string& source,
   if (options.scallopHeight && !(*options.scallopHeight < options.toolRadius))
     throw Error(fmt::format("the scallop height {} must be smaller than the tool radius {}",
                             *options.scallopHeight, options.toolRadius));
-  JobResult result;
+}
+
+ToolpathResult toolpaths(const Surface& surface, const ToolpathOptions& options,
+                         std::optional<OptimalSlicing> orientation, const JobControl& control) {
+  const JobControlScope scope(&control);
+  const std::string& source = options.source;
+  const auto start = std::chrono::steady_clock::now();
+  validateToolpathOptions(surface, options);
+  ToolpathResult result;
   result.orientation = std::move(orientation);
-  result.report.strategy = options.strategy;
+  result.report.strategy = strategyName(options.strategy);
   result.report.source = source;
   result.report.units = surface.units;
   result.report.toolRadius = options.toolRadius;
   result.report.scallopHeight = options.scallopHeight;
-  if (options.strategy != "contour" && options.strategy != "raster")
-    throw Error(fmt::format("unknown strategy '{}': expected contour or raster", options.strategy));
   // What goes wrong from here on is about the surface (or the planes against it): say which.
   try {
-    if (options.strategy == "contour") {
-      runContour(surface, options, result, progress);
+    if (options.strategy == Strategy::contour) {
+      runContour(surface, options, result);
     } else {
-      runRaster(surface, options, result, progress);
+      runRaster(surface, options, result);
     }
+  } catch (const Cancelled&) {
+    throw;
   } catch (const Error& error) {
     throw Error(fmt::format("{}: {}", source, error.what()));
   }
   result.unlinkedPath = result.path;
-  linkAndCheck(surface, source, options, result, progress);
+  linkAndCheck(surface, options, result);
   result.report.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }
 
-void addPasses(const Surface& surface, const std::string& source, const JobOptions& options,
-               const ToolPath& extra, JobResult& result, const Progress& progress) {
+void addPasses(const Surface& surface, const ToolpathOptions& options, const ToolPath& extra,
+               ToolpathResult& result) {
   if (extra.units != result.unlinkedPath.units || extra.toolRadius != result.unlinkedPath.toolRadius)
     throw Error("addPasses: the extra passes' units or tool radius differ from the job's");
   result.unlinkedPath.passes.insert(result.unlinkedPath.passes.end(), extra.passes.begin(), extra.passes.end());
-  linkAndCheck(surface, source, options, result, progress);
+  linkAndCheck(surface, options, result);
 }
 
 GcodeOptions defaultGcodeOptions(const Surface& surface, const ToolPath& path,

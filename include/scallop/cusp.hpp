@@ -115,6 +115,11 @@ namespace scallop {
 /// |kappa l| <= 2 pi (throws scallop::Error otherwise, or for R <= 0, l < 0, non-finite input).
 double cuspHeight(double l, double toolRadius, double kappa);
 
+/// The cusp between balls of radius R on neighbouring passes `spacing` apart on a flat surface:
+/// the scallop height a plan given --spacing is simulated against. Refused from 2 R up, where
+/// the balls do not meet and nothing bounds what is left between passes.
+double flatCusp(double radius, double spacing);
+
 /// The contact geometry of the model at one point: a = N . t = sin(angle(N, n)) >= 0,
 /// b = N . n, kappa along t.
 struct CrossGeometry {

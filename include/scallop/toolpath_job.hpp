@@ -1,14 +1,24 @@
 #pragma once
-// The work shared by `scallop paths` and `scallop plan`: from a surface and the user's
-// choices (strategy, tool radius, spacing or scallop height, plane normal or feed angle) to
-// the tool path, its report, the G-code and the figures. Errors propagate as scallop::Error.
+// The tool paths of a surface as `scallop paths` makes them (and `scallop plan`, plan.hpp,
+// before its G-code and simulated cut).
+//
+// Contract
+// --------
+// toolpaths(surface, options, control): from the user's choices (strategy, tool radius,
+// spacing or scallop height, plane normal or feed angle) to the finished tool path: passes by
+// the contour strategy on the optimal planes N* (or given ones) or the raster strategy, lifted
+// to the drop envelope, ordered and linked, and the ball checked against the whole surface.
+// The report (paths_output.hpp's PathsReport) holds every figure the CLI writes.
+// Errors: scallop::Error naming `options.source` (bad options are refused before any work);
+// scallop::Cancelled when `control`'s token is set (job_control.hpp), which also carries the
+// progress. Deterministic: the same input gives the same result for any thread count.
 
-#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "scallop/gcode.hpp"
+#include "scallop/job_control.hpp"
 #include "scallop/linking.hpp"
 #include "scallop/optimal_slicing.hpp"
 #include "scallop/paths_output.hpp"
@@ -17,8 +27,19 @@
 
 namespace scallop {
 
-struct JobOptions {
-  std::string strategy = "contour";     ///< "contour" or "raster"
+enum class Strategy {
+  contour,  ///< sections by parallel planes N . x = k Delta (the optimal N* unless given)
+  raster,   ///< vertical planes along a feed direction, each section's scallop hull
+};
+
+/// "contour" or "raster".
+const char* strategyName(Strategy strategy);
+/// The inverse of strategyName; scallop::Error naming the text otherwise.
+Strategy parseStrategy(const std::string& text);
+
+struct ToolpathOptions {
+  std::string source = "surface";       ///< the surface's name in errors and the report
+  Strategy strategy = Strategy::contour;
   double toolRadius = 0.0;              ///< R > 0
   std::optional<double> spacing;        ///< Delta, or
   std::optional<double> scallopHeight;  ///< H (0 < H < R): planes from H (cusp.hpp)
@@ -33,7 +54,7 @@ struct JobOptions {
   LinkOptions linking;
 };
 
-struct JobResult {
+struct ToolpathResult {
   PathsReport report;
   ToolPath path;
   /// The strategy's passes before linking (the same as `path` without linking): what
@@ -43,18 +64,20 @@ struct JobResult {
   std::optional<OptimalSlicing> orientation;     ///< when N* was computed
 };
 
-/// Progress lines for long steps ("orienting", "sections", ...); may be empty.
-using Progress = std::function<void(const std::string&)>;
+/// The checks toolpaths makes before any work: a positive finite tool radius at most 1000 times
+/// the surface's size, exactly one of spacing and scallop height, H < R. scallop::Error.
+void validateToolpathOptions(const Surface& surface, const ToolpathOptions& options);
 
-/// Computes the tool path (see JobOptions); `orientation`, when given, is reused as N*.
-JobResult runToolpathJob(const Surface& surface, const std::string& source,
-                         const JobOptions& options, std::optional<OptimalSlicing> orientation,
-                         const Progress& progress);
+/// Computes the tool path (see the contract); `orientation`, when given, is reused as N*.
+ToolpathResult toolpaths(const Surface& surface, const ToolpathOptions& options,
+                         std::optional<OptimalSlicing> orientation = std::nullopt,
+                         const JobControl& control = {});
 
-/// `extra` passes (rest finishing: same units and radius) added to the job's unlinked
-/// passes, and the whole linked and gouge-checked again as runToolpathJob does.
-void addPasses(const Surface& surface, const std::string& source, const JobOptions& options,
-               const ToolPath& extra, JobResult& result, const Progress& progress);
+/// `extra` passes (rest finishing: same units and radius) added to the result's unlinked
+/// passes, and the whole linked and gouge-checked again as toolpaths does. Runs under the
+/// job control installed on this thread (plan's).
+void addPasses(const Surface& surface, const ToolpathOptions& options, const ToolPath& extra,
+               ToolpathResult& result);
 
 /// G-code options that suit the surface's units: feeds 40 / 15 in/min or 1000 / 400
 /// mm/min, 10,000 rpm, and a safe height 0.2 in (5 mm) above the highest of the surface's

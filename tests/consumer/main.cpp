@@ -3,7 +3,8 @@
 // `pkg-config --cflags --libs scallop`. It reaches into scallop::io (a chain parsed from
 // text, a hull written as JSON) and scallop::core and the libraries core links (the scallop
 // hull; Qhull through the optimal slicing of a set of normals; Clipper through a Gauss map),
-// prints the tool path's length and exits 0 when every figure is as expected.
+// runs the whole plan through scallop::jobs with progress and cancel, prints the tool path's
+// length and exits 0 when every figure is as expected.
 // With SCALLOP_CONSUMER_CAD it also calls scallop::cad (OpenCASCADE) on a missing file.
 
 #include <cmath>
@@ -16,7 +17,9 @@
 #include "scallop/error.hpp"
 #include "scallop/gauss_map.hpp"
 #include "scallop/hull_json.hpp"
+#include "scallop/job_control.hpp"
 #include "scallop/mesh_slicing.hpp"
+#include "scallop/plan.hpp"
 #include "scallop/scallop_hull.hpp"
 #include "scallop/surface.hpp"
 #ifdef SCALLOP_CONSUMER_CAD
@@ -55,6 +58,39 @@ int main() {
     // The symmetrized Gauss map of a built-in surface (Clipper's polygon union).
     const scallop::GaussMap gaussMap = scallop::symmetrizedGaussMap(scallop::exampleSurface("paper-1"));
     check(gaussMap.kind == scallop::GaussMapKind::region && !gaussMap.loops.empty(), "Gauss map loops");
+
+    // The whole plan through scallop::jobs, with progress and a cancel: paper-1 at 0.01 in
+    // scallops; the progress never goes back and ends at 1; the program holds G-code; a second
+    // plan cancelled from its progress callback half way throws scallop::Cancelled.
+    const scallop::Surface paper1 = scallop::exampleSurface("paper-1");
+    scallop::PlanOptions planOptions;
+    planOptions.scallopHeight = 0.01;
+    scallop::JobControl control;
+    double last = 0.0;
+    int reports = 0;
+    bool monotone = true;
+    control.progress = [&](double fraction, const std::string&) {
+      monotone = monotone && fraction >= last;
+      last = fraction;
+      ++reports;
+    };
+    const scallop::PlanResult planned = scallop::plan(paper1, planOptions, control);
+    std::printf("plan: %d progress reports, %zu passes, %zu bytes of G-code\n", reports,
+                planned.toolpaths.path.passes.size(), planned.program.size());
+    check(monotone && last == 1.0 && reports > 5, "plan progress monotone, ending at 1");
+    check(planned.program.find("G1") != std::string::npos && planned.simulated.maxGouge < 1e-3, "plan program");
+    check(scallop::planFiles(paper1, planned).size() == 7, "plan files");
+    scallop::JobControl halfway;
+    halfway.progress = [&halfway](double fraction, const std::string&) {
+      if (fraction > 0.5) halfway.cancel.cancel();
+    };
+    bool cancelled = false;
+    try {
+      (void)scallop::plan(paper1, planOptions, halfway);
+    } catch (const scallop::Cancelled&) {
+      cancelled = true;
+    }
+    check(cancelled, "a plan cancelled half way throws scallop::Cancelled");
 
 #ifdef SCALLOP_CONSUMER_CAD
     bool refused = false;
