@@ -17,9 +17,10 @@ jobs="${JOBS:-$(nproc)}"
 # OpenCASCADE 7.6 reads STEP and IGES (libocct-data-exchange-dev pulls the other OCCT toolkits
 # and occt-misc, whose sample parts the tests read); its CMake files name libtbb.so, which only
 # libtbb-dev provides (Debian 12's packages do not depend on it).
+# python3-pybind11, python3-numpy and python3-dev build the Python module (python/) and run its tests.
 packages=(build-essential cmake pkg-config nlohmann-json3-dev libfmt-dev libcli11-dev libboost-dev
           libpolyclipping-dev libqhull-dev libocct-data-exchange-dev libtbb-dev
-          libgtest-dev libgmock-dev libbenchmark-dev)
+          libgtest-dev libgmock-dev libbenchmark-dev python3-pybind11 python3-numpy python3-dev)
 # The tests check the G-code writer with LinuxCNC's own interpreter, rs274 (gcode_test.cpp
 # fails without it). It runs headless; with --no-install-recommends it still pulls in about
 # 100 packages (Tcl/Tk, Python, GTK libraries): some 75 MB to download, 255 MB on disk.
