@@ -1,9 +1,11 @@
 # ctest -R Packaging (registered in tests/CMakeLists.txt): installs the build tree into a
 # fresh temporary prefix, builds tests/consumer against it with find_package(scallop) and
-# with `pkg-config --cflags --libs scallop`, runs both, and removes the temporary files.
+# with `pkg-config --cflags --libs scallop`, runs both, runs tests/consumer/consumer.py on the
+# installed Python module (when built), and removes the temporary files.
 #
 # cmake -DBUILD_DIR=... -DCONSUMER_DIR=... -DCONFIG=... -DGENERATOR=... -DCXX_COMPILER=...
 #       -DPKG_CONFIG=... -DLIBDIR=... -DVERSION=... -DWITH_CAD=ON|OFF -DCOMPONENTS=a,b
+#       [-DPYTHON=interpreter]
 #       -P packaging_test.cmake
 cmake_minimum_required(VERSION 3.25)
 
@@ -101,5 +103,23 @@ if(NOT output MATCHES "${expected_output}")
 endif()
 string(STRIP "${output}" output)
 message(STATUS "pkg-config consumer: ${output}")
+
+# 4. Python (when the module was built, -DPYTHON=<interpreter>): the installed module, found
+# under the prefix wherever its install rule put it, runs consumer.py's whole plan.
+if(NOT "${PYTHON}" STREQUAL "")
+  file(GLOB_RECURSE modules "${prefix}/*/scallop.cpython-*.so")
+  list(LENGTH modules count)
+  if(NOT count EQUAL 1)
+    fail("expected one installed Python module under ${prefix}, found ${count}: ${modules}")
+  endif()
+  get_filename_component(module_dir "${modules}" DIRECTORY)
+  run("running the Python consumer" "${CMAKE_COMMAND}" -E env "PYTHONPATH=${module_dir}" PYTHONDONTWRITEBYTECODE=1
+      "${PYTHON}" "${CONSUMER_DIR}/consumer.py" "${prefix}")
+  if(NOT output MATCHES "^plan: [0-9]+ progress reports, [0-9]+ passes, [0-9]+ bytes of G-code; cancelled half way\n$")
+    fail("the Python consumer printed: '${output}'")
+  endif()
+  string(STRIP "${output}" output)
+  message(STATUS "Python consumer: ${output}")
+endif()
 
 file(REMOVE_RECURSE "${work}")
