@@ -10,7 +10,7 @@
 #include <fmt/format.h>
 
 #include "scallop/error.hpp"
-#include "scallop/vector.hpp"
+#include "scallop/geometry/vector.hpp"
 
 namespace scallop::cli {
 

@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "scallop/vector.hpp"
+#include "scallop/geometry/vector.hpp"
 
 namespace scallop::cli {
 

@@ -16,13 +16,13 @@
 
 #include "arguments.hpp"
 #include "commands.hpp"
-#include "scallop/chain_io.hpp"
+#include "scallop/io/chain_io.hpp"
 #include "scallop/error.hpp"
-#include "scallop/file_output.hpp"
-#include "scallop/hull_json.hpp"
-#include "scallop/hull_svg.hpp"
-#include "scallop/path_sampling.hpp"
-#include "scallop/scallop_hull.hpp"
+#include "scallop/io/file_output.hpp"
+#include "scallop/io/hull_json.hpp"
+#include "scallop/io/hull_svg.hpp"
+#include "scallop/paths/path_sampling.hpp"
+#include "scallop/paths/scallop_hull.hpp"
 
 namespace scallop::cli {
 namespace {

@@ -6,8 +6,8 @@
 
 #include <CLI/CLI.hpp>
 
-#include "scallop/paths_output.hpp"
-#include "scallop/surface.hpp"
+#include "scallop/io/paths_output.hpp"
+#include "scallop/geometry/surface.hpp"
 
 namespace scallop::cli {
 

@@ -16,9 +16,9 @@
 #include <fmt/format.h>
 
 #include "arguments.hpp"
-#include "scallop/cusp.hpp"
+#include "scallop/paths/cusp.hpp"
 #include "scallop/error.hpp"
-#include "scallop/mesh_drop.hpp"
+#include "scallop/paths/mesh_drop.hpp"
 
 namespace scallop::cli {
 namespace {

@@ -10,13 +10,13 @@
 #include <optional>
 #include <string>
 
-#include "scallop/cad_import.hpp"
-#include "scallop/cad_tessellation.hpp"
-#include "scallop/cut_simulation.hpp"
-#include "scallop/mesh.hpp"
-#include "scallop/mesh_drop.hpp"
-#include "scallop/mesh_raster.hpp"
-#include "scallop/paths_output.hpp"
+#include "scallop/cad/cad_import.hpp"
+#include "scallop/cad/cad_tessellation.hpp"
+#include "scallop/paths/cut_simulation.hpp"
+#include "scallop/geometry/mesh.hpp"
+#include "scallop/paths/mesh_drop.hpp"
+#include "scallop/paths/mesh_raster.hpp"
+#include "scallop/io/paths_output.hpp"
 
 namespace scallop::cli {
 

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "scallop/file_output.hpp"
+#include "scallop/io/file_output.hpp"
 
 namespace scallop::cli {
 

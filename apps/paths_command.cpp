@@ -16,15 +16,15 @@
 #include "arguments.hpp"
 #include "commands.hpp"
 #include "output_directory.hpp"
-#include "scallop/cad_tessellation.hpp"
+#include "scallop/cad/cad_tessellation.hpp"
 #include "scallop/error.hpp"
-#include "scallop/gcode.hpp"
-#include "scallop/paths_output.hpp"
-#include "scallop/surface.hpp"
+#include "scallop/io/gcode.hpp"
+#include "scallop/io/paths_output.hpp"
+#include "scallop/geometry/surface.hpp"
 #include "surface_options.hpp"
 #include "linking_options.hpp"
 #include "mesh_job.hpp"
-#include "scallop/toolpath_job.hpp"
+#include "scallop/jobs/toolpath_job.hpp"
 
 namespace scallop::cli {
 namespace {

@@ -13,10 +13,10 @@
 #include <fmt/format.h>
 
 #include "arguments.hpp"
-#include "scallop/cad_import.hpp"
+#include "scallop/cad/cad_import.hpp"
 #include "scallop/error.hpp"
-#include "scallop/mesh.hpp"
-#include "scallop/surface_io.hpp"
+#include "scallop/geometry/mesh.hpp"
+#include "scallop/io/surface_io.hpp"
 
 namespace scallop::cli {
 namespace {

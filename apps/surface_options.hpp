@@ -9,11 +9,11 @@
 
 #include <CLI/CLI.hpp>
 
-#include "scallop/cad_import.hpp"
-#include "scallop/cad_tessellation.hpp"
-#include "scallop/gcode.hpp"
-#include "scallop/mesh.hpp"
-#include "scallop/surface.hpp"
+#include "scallop/cad/cad_import.hpp"
+#include "scallop/cad/cad_tessellation.hpp"
+#include "scallop/io/gcode.hpp"
+#include "scallop/geometry/mesh.hpp"
+#include "scallop/geometry/surface.hpp"
 
 namespace scallop::cli {
 

@@ -17,12 +17,12 @@
 #include "arguments.hpp"
 #include "commands.hpp"
 #include "output_directory.hpp"
-#include "scallop/cad_tessellation.hpp"
-#include "scallop/cut_simulation.hpp"
+#include "scallop/cad/cad_tessellation.hpp"
+#include "scallop/paths/cut_simulation.hpp"
 #include "scallop/error.hpp"
-#include "scallop/gcode_reader.hpp"
-#include "scallop/surface.hpp"
-#include "scallop/verify_output.hpp"
+#include "scallop/io/gcode_reader.hpp"
+#include "scallop/geometry/surface.hpp"
+#include "scallop/io/verify_output.hpp"
 #include "surface_options.hpp"
 
 namespace scallop::cli {

@@ -16,10 +16,10 @@
 #include <limits>
 #include <string>
 
-#include "scallop/bezier.hpp"
-#include "scallop/mesh.hpp"
-#include "scallop/mesh_drop.hpp"
-#include "scallop/surface.hpp"
+#include "scallop/geometry/bezier.hpp"
+#include "scallop/geometry/mesh.hpp"
+#include "scallop/paths/mesh_drop.hpp"
+#include "scallop/geometry/surface.hpp"
 
 namespace {
 

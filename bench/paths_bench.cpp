@@ -35,15 +35,15 @@
 #include <string>
 #include <vector>
 
-#include "scallop/contour.hpp"
-#include "scallop/envelope.hpp"
-#include "scallop/gcode.hpp"
-#include "scallop/gouge.hpp"
-#include "scallop/linking.hpp"
-#include "scallop/optimal_slicing.hpp"
-#include "scallop/raster.hpp"
-#include "scallop/section.hpp"
-#include "scallop/surface.hpp"
+#include "scallop/paths/contour.hpp"
+#include "scallop/paths/envelope.hpp"
+#include "scallop/io/gcode.hpp"
+#include "scallop/paths/gouge.hpp"
+#include "scallop/paths/linking.hpp"
+#include "scallop/slicing/optimal_slicing.hpp"
+#include "scallop/paths/raster.hpp"
+#include "scallop/paths/section.hpp"
+#include "scallop/geometry/surface.hpp"
 
 namespace {
 

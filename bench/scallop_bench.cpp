@@ -14,11 +14,11 @@
 #include <map>
 #include <random>
 
-#include "scallop/gauss_map.hpp"
-#include "scallop/medial_axis.hpp"
-#include "scallop/optimal_slicing.hpp"
-#include "scallop/scallop_hull.hpp"
-#include "scallop/surface.hpp"
+#include "scallop/slicing/gauss_map.hpp"
+#include "scallop/slicing/medial_axis.hpp"
+#include "scallop/slicing/optimal_slicing.hpp"
+#include "scallop/paths/scallop_hull.hpp"
+#include "scallop/geometry/surface.hpp"
 
 namespace {
 

@@ -13,13 +13,13 @@
 #include <cstdint>
 #include <string>
 
-#include "scallop/contour.hpp"
-#include "scallop/cut_simulation.hpp"
-#include "scallop/gcode.hpp"
-#include "scallop/gcode_reader.hpp"
-#include "scallop/optimal_slicing.hpp"
-#include "scallop/raster.hpp"
-#include "scallop/surface.hpp"
+#include "scallop/paths/contour.hpp"
+#include "scallop/paths/cut_simulation.hpp"
+#include "scallop/io/gcode.hpp"
+#include "scallop/io/gcode_reader.hpp"
+#include "scallop/slicing/optimal_slicing.hpp"
+#include "scallop/paths/raster.hpp"
+#include "scallop/geometry/surface.hpp"
 
 namespace {
 

@@ -31,20 +31,20 @@ endfunction()
 
 scallop_install_export(scallopTargets scallop_core scallop_io scallop_jobs scallop)
 
-# The public headers, cad_*.hpp only with scallop::cad. The globs run at install time.
+# The public headers, by layer (include/scallop/<layer>/), cad/ only with scallop::cad. The
+# globs run at install time.
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/scallop
   DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
   COMPONENT scallop_Development
-  FILES_MATCHING PATTERN "*.hpp" PATTERN "cad_*.hpp" EXCLUDE)
+  FILES_MATCHING PATTERN "*.hpp" PATTERN "cad" EXCLUDE)
 
 if(SCALLOP_BUILD_CAD)
   # An export set of its own, so that find_package(scallop) looks for OpenCASCADE only
   # when scallop::cad is asked for.
   scallop_install_export(scallopCadTargets scallop_cad)
-  install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/scallop
-    DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
-    COMPONENT scallop_Development
-    FILES_MATCHING PATTERN "cad_*.hpp")
+  install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/scallop/cad
+    DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/scallop
+    COMPONENT scallop_Development)
 endif()
 
 if(SCALLOP_BUILD_CLI)

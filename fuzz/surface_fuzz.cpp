@@ -1,8 +1,8 @@
 // libFuzzer target: the surface readers (surface.hpp's JSON, surface_io.hpp's .bpt), each
 // with the full check, and the patch selection of the CLI's --patches.
 #include "fuzz_target.hpp"
-#include "scallop/surface.hpp"
-#include "scallop/surface_io.hpp"
+#include "scallop/geometry/surface.hpp"
+#include "scallop/io/surface_io.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   return scallop::fuzz::run(data, size, [](std::string_view text) {

@@ -52,7 +52,7 @@
 #include <utility>
 #include <vector>
 
-#include "scallop/bernstein.hpp"
+#include "scallop/geometry/bernstein.hpp"
 #include "scallop/error.hpp"
 
 namespace {

@@ -47,10 +47,10 @@
 #include <utility>
 #include <vector>
 
-#include "scallop/bernstein.hpp"
-#include "scallop/bezier.hpp"
+#include "scallop/geometry/bernstein.hpp"
+#include "scallop/geometry/bezier.hpp"
 #include "scallop/error.hpp"
-#include "scallop/vector.hpp"
+#include "scallop/geometry/vector.hpp"
 #include "rational_patches.hpp"
 
 namespace {

@@ -26,8 +26,8 @@
 #include <TopoDS_Face.hxx>
 #include <TopoDS_Shape.hxx>
 
-#include "scallop/bezier.hpp"
-#include "scallop/surface.hpp"
+#include "scallop/geometry/bezier.hpp"
+#include "scallop/geometry/surface.hpp"
 
 namespace scallop::test {
 

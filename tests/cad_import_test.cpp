@@ -49,13 +49,13 @@
 #include "cad_fixtures.hpp"
 #include "cli_fixture.hpp"
 #include "message_checks.hpp"
-#include "scallop/bezier.hpp"
-#include "scallop/cad_import.hpp"
+#include "scallop/geometry/bezier.hpp"
+#include "scallop/cad/cad_import.hpp"
 #include "scallop/error.hpp"
-#include "scallop/cut_simulation.hpp"
-#include "scallop/gcode_reader.hpp"
-#include "scallop/optimal_slicing.hpp"
-#include "scallop/surface.hpp"
+#include "scallop/paths/cut_simulation.hpp"
+#include "scallop/io/gcode_reader.hpp"
+#include "scallop/slicing/optimal_slicing.hpp"
+#include "scallop/geometry/surface.hpp"
 
 namespace {
 

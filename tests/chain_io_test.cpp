@@ -22,8 +22,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "scallop/chain.hpp"
-#include "scallop/chain_io.hpp"
+#include "scallop/paths/chain.hpp"
+#include "scallop/io/chain_io.hpp"
 #include "scallop/error.hpp"
 
 namespace scallop {

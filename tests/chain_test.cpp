@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "scallop/chain.hpp"
+#include "scallop/paths/chain.hpp"
 #include "scallop/error.hpp"
 
 namespace {

@@ -21,9 +21,9 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_fixture.hpp"
-#include "scallop/chain.hpp"
-#include "scallop/chain_io.hpp"
-#include "scallop/surface.hpp"
+#include "scallop/paths/chain.hpp"
+#include "scallop/io/chain_io.hpp"
+#include "scallop/geometry/surface.hpp"
 
 namespace scallop {
 namespace {

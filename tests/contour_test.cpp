@@ -9,10 +9,10 @@
 #include <numbers>
 #include <random>
 
-#include "scallop/bezier.hpp"
-#include "scallop/contour.hpp"
+#include "scallop/geometry/bezier.hpp"
+#include "scallop/paths/contour.hpp"
 #include "scallop/error.hpp"
-#include "scallop/surface.hpp"
+#include "scallop/geometry/surface.hpp"
 
 namespace {
 

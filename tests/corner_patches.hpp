@@ -5,8 +5,8 @@
 #include <random>
 #include <vector>
 
-#include "scallop/bezier.hpp"
-#include "scallop/vector.hpp"
+#include "scallop/geometry/bezier.hpp"
+#include "scallop/geometry/vector.hpp"
 
 namespace scallop::test {
 

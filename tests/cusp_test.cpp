@@ -20,15 +20,15 @@
 #include <cstdlib>
 #include <unordered_map>
 
-#include "scallop/bezier.hpp"
-#include "scallop/contour.hpp"
-#include "scallop/cusp.hpp"
-#include "scallop/envelope.hpp"
+#include "scallop/geometry/bezier.hpp"
+#include "scallop/paths/contour.hpp"
+#include "scallop/paths/cusp.hpp"
+#include "scallop/paths/envelope.hpp"
 #include "scallop/error.hpp"
-#include "scallop/gouge.hpp"
-#include "scallop/raster.hpp"
-#include "scallop/section.hpp"
-#include "scallop/surface.hpp"
+#include "scallop/paths/gouge.hpp"
+#include "scallop/paths/raster.hpp"
+#include "scallop/paths/section.hpp"
+#include "scallop/geometry/surface.hpp"
 
 namespace {
 

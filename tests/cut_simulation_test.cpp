@@ -16,17 +16,17 @@
 #include <vector>
 
 #include "mesh_fixtures.hpp"
-#include "scallop/contour.hpp"
-#include "scallop/cut_simulation.hpp"
-#include "scallop/envelope.hpp"
+#include "scallop/paths/contour.hpp"
+#include "scallop/paths/cut_simulation.hpp"
+#include "scallop/paths/envelope.hpp"
 #include "scallop/error.hpp"
-#include "scallop/gcode.hpp"
-#include "scallop/gcode_reader.hpp"
-#include "scallop/gouge.hpp"
-#include "scallop/optimal_slicing.hpp"
-#include "scallop/raster.hpp"
-#include "scallop/surface.hpp"
-#include "scallop/verify_output.hpp"
+#include "scallop/io/gcode.hpp"
+#include "scallop/io/gcode_reader.hpp"
+#include "scallop/paths/gouge.hpp"
+#include "scallop/slicing/optimal_slicing.hpp"
+#include "scallop/paths/raster.hpp"
+#include "scallop/geometry/surface.hpp"
+#include "scallop/io/verify_output.hpp"
 #include "rational_patches.hpp"
 
 namespace scallop {

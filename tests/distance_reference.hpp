@@ -11,9 +11,9 @@
 #include <limits>
 #include <vector>
 
-#include "scallop/bezier.hpp"
-#include "scallop/surface.hpp"
-#include "scallop/vector.hpp"
+#include "scallop/geometry/bezier.hpp"
+#include "scallop/geometry/surface.hpp"
+#include "scallop/geometry/vector.hpp"
 
 namespace scallop::reference {
 

@@ -15,14 +15,14 @@
 #include <vector>
 
 #include "distance_reference.hpp"
-#include "scallop/contour.hpp"
-#include "scallop/cut_simulation.hpp"
-#include "scallop/envelope.hpp"
+#include "scallop/paths/contour.hpp"
+#include "scallop/paths/cut_simulation.hpp"
+#include "scallop/paths/envelope.hpp"
 #include "scallop/error.hpp"
-#include "scallop/gouge.hpp"
-#include "scallop/optimal_slicing.hpp"
-#include "scallop/raster.hpp"
-#include "scallop/surface.hpp"
+#include "scallop/paths/gouge.hpp"
+#include "scallop/slicing/optimal_slicing.hpp"
+#include "scallop/paths/raster.hpp"
+#include "scallop/geometry/surface.hpp"
 
 namespace scallop {
 namespace {

@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "scallop/face_trim.hpp"
+#include "scallop/geometry/face_trim.hpp"
 
 namespace {
 

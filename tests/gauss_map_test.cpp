@@ -14,13 +14,13 @@
 #include <utility>
 #include <vector>
 
-#include "scallop/bezier.hpp"
+#include "scallop/geometry/bezier.hpp"
 #include "scallop/error.hpp"
-#include "scallop/gauss_map.hpp"
-#include "scallop/medial_axis.hpp"
-#include "scallop/optimal_slicing.hpp"
-#include "scallop/stereographic.hpp"
-#include "scallop/surface.hpp"
+#include "scallop/slicing/gauss_map.hpp"
+#include "scallop/slicing/medial_axis.hpp"
+#include "scallop/slicing/optimal_slicing.hpp"
+#include "scallop/slicing/stereographic.hpp"
+#include "scallop/geometry/surface.hpp"
 #include "corner_patches.hpp"
 #include "gauss_references.hpp"
 

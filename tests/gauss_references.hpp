@@ -10,10 +10,10 @@
 #include <utility>
 #include <vector>
 
-#include "scallop/bezier.hpp"
+#include "scallop/geometry/bezier.hpp"
 #include "scallop/error.hpp"
-#include "scallop/surface.hpp"
-#include "scallop/vector.hpp"
+#include "scallop/geometry/surface.hpp"
+#include "scallop/geometry/vector.hpp"
 
 namespace scallop::reference {
 

@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "gauss_references.hpp"
-#include "scallop/bezier.hpp"
-#include "scallop/surface.hpp"
+#include "scallop/geometry/bezier.hpp"
+#include "scallop/geometry/surface.hpp"
 
 namespace scallop {
 namespace {

@@ -16,10 +16,10 @@
 #include "message_checks.hpp"
 #include "rs274.hpp"
 #include "scallop/error.hpp"
-#include "scallop/gcode.hpp"
-#include "scallop/gcode_reader.hpp"
-#include "scallop/raster.hpp"
-#include "scallop/surface.hpp"
+#include "scallop/io/gcode.hpp"
+#include "scallop/io/gcode_reader.hpp"
+#include "scallop/paths/raster.hpp"
+#include "scallop/geometry/surface.hpp"
 
 namespace scallop {
 namespace {

@@ -45,11 +45,11 @@
 #include <vector>
 
 #include "rs274.hpp"
-#include "scallop/contour.hpp"
+#include "scallop/paths/contour.hpp"
 #include "scallop/error.hpp"
-#include "scallop/gcode.hpp"
-#include "scallop/linking.hpp"
-#include "scallop/toolpath.hpp"
+#include "scallop/io/gcode.hpp"
+#include "scallop/paths/linking.hpp"
+#include "scallop/paths/toolpath.hpp"
 
 #ifndef SCALLOP_RS274_PATH
 #define SCALLOP_RS274_PATH ""

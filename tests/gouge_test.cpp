@@ -17,11 +17,11 @@
 #include <string>
 #include <vector>
 
-#include "scallop/bezier.hpp"
+#include "scallop/geometry/bezier.hpp"
 #include "scallop/error.hpp"
-#include "scallop/gouge.hpp"
-#include "scallop/surface.hpp"
-#include "scallop/toolpath.hpp"
+#include "scallop/paths/gouge.hpp"
+#include "scallop/geometry/surface.hpp"
+#include "scallop/paths/toolpath.hpp"
 #include "distance_reference.hpp"
 #include "rational_patches.hpp"
 

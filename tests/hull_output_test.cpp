@@ -26,13 +26,13 @@
 
 #include <nlohmann/json.hpp>
 
-#include "scallop/chain.hpp"
-#include "scallop/chain_io.hpp"
+#include "scallop/paths/chain.hpp"
+#include "scallop/io/chain_io.hpp"
 #include "scallop/error.hpp"
-#include "scallop/file_output.hpp"
-#include "scallop/hull_json.hpp"
-#include "scallop/hull_svg.hpp"
-#include "scallop/scallop_hull.hpp"
+#include "scallop/io/file_output.hpp"
+#include "scallop/io/hull_json.hpp"
+#include "scallop/io/hull_svg.hpp"
+#include "scallop/paths/scallop_hull.hpp"
 
 namespace scallop {
 namespace {

@@ -25,13 +25,13 @@
 #include <vector>
 
 #include "distance_reference.hpp"
-#include "scallop/contour.hpp"
+#include "scallop/paths/contour.hpp"
 #include "scallop/error.hpp"
-#include "scallop/gcode.hpp"
-#include "scallop/linking.hpp"
-#include "scallop/optimal_slicing.hpp"
-#include "scallop/raster.hpp"
-#include "scallop/surface.hpp"
+#include "scallop/io/gcode.hpp"
+#include "scallop/paths/linking.hpp"
+#include "scallop/slicing/optimal_slicing.hpp"
+#include "scallop/paths/raster.hpp"
+#include "scallop/geometry/surface.hpp"
 
 namespace scallop {
 namespace {

@@ -40,7 +40,7 @@
 #include <vector>
 
 #include "scallop/error.hpp"
-#include "scallop/medial_axis.hpp"
+#include "scallop/slicing/medial_axis.hpp"
 
 namespace scallop {
 namespace {

@@ -22,7 +22,7 @@
 //                                    reference
 //   MeshDrop.BadInput                R <= 0, NaN, an empty mesh, bad indices, bad line options
 
-#include "scallop/mesh_drop.hpp"
+#include "scallop/paths/mesh_drop.hpp"
 
 #include <gtest/gtest.h>
 
@@ -38,7 +38,7 @@
 
 #include "mesh_fixtures.hpp"
 #include "scallop/error.hpp"
-#include "scallop/mesh.hpp"
+#include "scallop/geometry/mesh.hpp"
 
 namespace {
 

@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <random>
 
-#include "scallop/mesh.hpp"
+#include "scallop/geometry/mesh.hpp"
 
 namespace scallop::test {
 

@@ -15,11 +15,11 @@
 #include <vector>
 
 #include "mesh_fixtures.hpp"
-#include "scallop/cut_simulation.hpp"
+#include "scallop/paths/cut_simulation.hpp"
 #include "scallop/error.hpp"
-#include "scallop/mesh.hpp"
-#include "scallop/mesh_drop.hpp"
-#include "scallop/mesh_raster.hpp"
+#include "scallop/geometry/mesh.hpp"
+#include "scallop/paths/mesh_drop.hpp"
+#include "scallop/paths/mesh_raster.hpp"
 
 namespace scallop {
 namespace {

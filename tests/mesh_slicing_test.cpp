@@ -5,7 +5,7 @@
 // (A first reference refined the samples by a compass search: it stalls on the ridges of the
 // max-min function, 1e-5 to 6e-4 rad short of the hull's answer.)
 
-#include "scallop/mesh_slicing.hpp"
+#include "scallop/slicing/mesh_slicing.hpp"
 
 #include <gtest/gtest.h>
 
@@ -15,10 +15,10 @@
 #include <random>
 #include <vector>
 
-#include "scallop/bezier.hpp"
+#include "scallop/geometry/bezier.hpp"
 #include "scallop/error.hpp"
-#include "scallop/optimal_slicing.hpp"
-#include "scallop/surface.hpp"
+#include "scallop/slicing/optimal_slicing.hpp"
+#include "scallop/geometry/surface.hpp"
 
 namespace {
 

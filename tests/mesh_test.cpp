@@ -2,7 +2,7 @@
 // meshes, fixed seeds) read back exactly, vertices merged, and every malformed file refused
 // with a message that names the file and what is wrong.
 
-#include "scallop/mesh.hpp"
+#include "scallop/geometry/mesh.hpp"
 
 #include <gtest/gtest.h>
 

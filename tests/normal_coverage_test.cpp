@@ -15,12 +15,12 @@
 #include <utility>
 #include <vector>
 
-#include "scallop/bezier.hpp"
+#include "scallop/geometry/bezier.hpp"
 #include "scallop/error.hpp"
-#include "scallop/gauss_map.hpp"
-#include "scallop/normal_coverage.hpp"
-#include "scallop/optimal_slicing.hpp"
-#include "scallop/surface.hpp"
+#include "scallop/slicing/gauss_map.hpp"
+#include "scallop/slicing/normal_coverage.hpp"
+#include "scallop/slicing/optimal_slicing.hpp"
+#include "scallop/geometry/surface.hpp"
 
 namespace {
 

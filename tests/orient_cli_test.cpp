@@ -18,10 +18,10 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_fixture.hpp"
-#include "scallop/mesh.hpp"
-#include "scallop/mesh_slicing.hpp"
-#include "scallop/optimal_slicing.hpp"
-#include "scallop/surface.hpp"
+#include "scallop/geometry/mesh.hpp"
+#include "scallop/slicing/mesh_slicing.hpp"
+#include "scallop/slicing/optimal_slicing.hpp"
+#include "scallop/geometry/surface.hpp"
 
 namespace scallop {
 namespace {

@@ -23,9 +23,9 @@
 #include <nlohmann/json.hpp>
 
 #include "scallop/error.hpp"
-#include "scallop/optimal_slicing.hpp"
-#include "scallop/orient_output.hpp"
-#include "scallop/surface.hpp"
+#include "scallop/slicing/optimal_slicing.hpp"
+#include "scallop/io/orient_output.hpp"
+#include "scallop/geometry/surface.hpp"
 
 namespace scallop {
 namespace {

@@ -53,7 +53,7 @@ foreach(component IN LISTS COMPONENTS)
       --component ${component} ${config_args})
 endforeach()
 foreach(file IN ITEMS "${LIBDIR}/cmake/scallop/scallopConfig.cmake" "${LIBDIR}/pkgconfig/scallop.pc"
-                      include/scallop/scallop_hull.hpp)
+                      include/scallop/paths/scallop_hull.hpp)
   if(NOT EXISTS "${prefix}/${file}")
     fail("not installed: ${file}")
   endif()

@@ -13,11 +13,11 @@
 #include <string>
 #include <vector>
 
-#include "scallop/chain.hpp"
-#include "scallop/chain_io.hpp"
+#include "scallop/paths/chain.hpp"
+#include "scallop/io/chain_io.hpp"
 #include "scallop/error.hpp"
-#include "scallop/path_sampling.hpp"
-#include "scallop/scallop_hull.hpp"
+#include "scallop/paths/path_sampling.hpp"
+#include "scallop/paths/scallop_hull.hpp"
 
 namespace scallop {
 namespace {

@@ -19,10 +19,10 @@
 #include "rs274.hpp"
 #include "distance_reference.hpp"
 #include "rational_patches.hpp"
-#include "scallop/bezier.hpp"
-#include "scallop/cut_simulation.hpp"
-#include "scallop/gcode_reader.hpp"
-#include "scallop/surface.hpp"
+#include "scallop/geometry/bezier.hpp"
+#include "scallop/paths/cut_simulation.hpp"
+#include "scallop/io/gcode_reader.hpp"
+#include "scallop/geometry/surface.hpp"
 
 namespace {
 

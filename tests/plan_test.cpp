@@ -2,7 +2,7 @@
 // the CLI writes, refuses bad options before any work, reports monotone progress, and stops
 // with scallop::Cancelled soon after a cancel at any moment.
 
-#include "scallop/plan.hpp"
+#include "scallop/jobs/plan.hpp"
 
 #include <gtest/gtest.h>
 
@@ -20,7 +20,7 @@
 #include "cli_fixture.hpp"
 #include "scallop/error.hpp"
 #include "scallop/job_control.hpp"
-#include "scallop/surface.hpp"
+#include "scallop/geometry/surface.hpp"
 
 namespace scallop {
 namespace {

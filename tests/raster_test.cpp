@@ -17,12 +17,12 @@
 #include <string>
 #include <vector>
 
-#include "scallop/bezier.hpp"
-#include "scallop/chain.hpp"
-#include "scallop/contour.hpp"
+#include "scallop/geometry/bezier.hpp"
+#include "scallop/paths/chain.hpp"
+#include "scallop/paths/contour.hpp"
 #include "scallop/error.hpp"
-#include "scallop/raster.hpp"
-#include "scallop/surface.hpp"
+#include "scallop/paths/raster.hpp"
+#include "scallop/geometry/surface.hpp"
 #include "distance_reference.hpp"
 
 namespace {

@@ -7,7 +7,7 @@
 #include <random>
 #include <utility>
 
-#include "scallop/bezier.hpp"
+#include "scallop/geometry/bezier.hpp"
 
 namespace scallop::test {
 

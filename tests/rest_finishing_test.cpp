@@ -14,12 +14,12 @@
 #include <vector>
 
 #include "distance_reference.hpp"
-#include "scallop/contour.hpp"
-#include "scallop/cut_simulation.hpp"
+#include "scallop/paths/contour.hpp"
+#include "scallop/paths/cut_simulation.hpp"
 #include "scallop/error.hpp"
-#include "scallop/optimal_slicing.hpp"
-#include "scallop/rest_finishing.hpp"
-#include "scallop/surface.hpp"
+#include "scallop/slicing/optimal_slicing.hpp"
+#include "scallop/paths/rest_finishing.hpp"
+#include "scallop/geometry/surface.hpp"
 
 namespace scallop {
 namespace {

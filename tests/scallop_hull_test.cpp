@@ -58,9 +58,9 @@
 #include <utility>
 #include <vector>
 
-#include "scallop/chain.hpp"
+#include "scallop/paths/chain.hpp"
 #include "scallop/error.hpp"
-#include "scallop/scallop_hull.hpp"
+#include "scallop/paths/scallop_hull.hpp"
 
 namespace {
 

@@ -15,10 +15,10 @@
 #include <random>
 #include <vector>
 
-#include "scallop/bezier.hpp"
+#include "scallop/geometry/bezier.hpp"
 #include "scallop/error.hpp"
-#include "scallop/section.hpp"
-#include "scallop/surface.hpp"
+#include "scallop/paths/section.hpp"
+#include "scallop/geometry/surface.hpp"
 #include "rational_patches.hpp"
 
 namespace {

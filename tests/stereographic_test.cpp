@@ -19,8 +19,8 @@
 #include <vector>
 
 #include "scallop/error.hpp"
-#include "scallop/stereographic.hpp"
-#include "scallop/vector.hpp"
+#include "scallop/slicing/stereographic.hpp"
+#include "scallop/geometry/vector.hpp"
 
 namespace scallop {
 namespace {

@@ -22,8 +22,8 @@
 #include "cli_fixture.hpp"
 #include "message_checks.hpp"
 #include "scallop/error.hpp"
-#include "scallop/surface.hpp"
-#include "scallop/surface_io.hpp"
+#include "scallop/geometry/surface.hpp"
+#include "scallop/io/surface_io.hpp"
 
 namespace scallop {
 namespace {

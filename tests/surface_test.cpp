@@ -21,10 +21,10 @@
 
 #include "corner_patches.hpp"
 #include "message_checks.hpp"
-#include "scallop/bernstein.hpp"
-#include "scallop/bezier.hpp"
+#include "scallop/geometry/bernstein.hpp"
+#include "scallop/geometry/bezier.hpp"
 #include "scallop/error.hpp"
-#include "scallop/surface.hpp"
+#include "scallop/geometry/surface.hpp"
 
 namespace scallop {
 namespace {

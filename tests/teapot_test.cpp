@@ -20,8 +20,8 @@
 
 #include "gauss_references.hpp"
 #include "scallop/error.hpp"
-#include "scallop/optimal_slicing.hpp"
-#include "scallop/surface.hpp"
+#include "scallop/slicing/optimal_slicing.hpp"
+#include "scallop/geometry/surface.hpp"
 
 namespace scallop {
 namespace {

@@ -15,12 +15,12 @@
 
 #include "gauss_references.hpp"
 #include "rational_patches.hpp"
-#include "scallop/bezier.hpp"
+#include "scallop/geometry/bezier.hpp"
 #include "scallop/error.hpp"
-#include "scallop/mesh_slicing.hpp"
-#include "scallop/optimal_slicing.hpp"
-#include "scallop/surface.hpp"
-#include "scallop/trimmed_patch.hpp"
+#include "scallop/slicing/mesh_slicing.hpp"
+#include "scallop/slicing/optimal_slicing.hpp"
+#include "scallop/geometry/surface.hpp"
+#include "scallop/geometry/trimmed_patch.hpp"
 
 namespace {
 

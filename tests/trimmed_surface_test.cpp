@@ -22,13 +22,13 @@
 #include <utility>
 #include <vector>
 
-#include "scallop/bezier.hpp"
-#include "scallop/cut_simulation.hpp"
+#include "scallop/geometry/bezier.hpp"
+#include "scallop/paths/cut_simulation.hpp"
 #include "scallop/error.hpp"
-#include "scallop/face_trim.hpp"
-#include "scallop/gouge.hpp"
-#include "scallop/section.hpp"
-#include "scallop/surface.hpp"
+#include "scallop/geometry/face_trim.hpp"
+#include "scallop/paths/gouge.hpp"
+#include "scallop/paths/section.hpp"
+#include "scallop/geometry/surface.hpp"
 
 namespace {
 

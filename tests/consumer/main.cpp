@@ -13,17 +13,17 @@
 #include <numbers>
 #include <string>
 
-#include "scallop/chain_io.hpp"
+#include "scallop/io/chain_io.hpp"
 #include "scallop/error.hpp"
-#include "scallop/gauss_map.hpp"
-#include "scallop/hull_json.hpp"
+#include "scallop/slicing/gauss_map.hpp"
+#include "scallop/io/hull_json.hpp"
 #include "scallop/job_control.hpp"
-#include "scallop/mesh_slicing.hpp"
-#include "scallop/plan.hpp"
-#include "scallop/scallop_hull.hpp"
-#include "scallop/surface.hpp"
+#include "scallop/slicing/mesh_slicing.hpp"
+#include "scallop/jobs/plan.hpp"
+#include "scallop/paths/scallop_hull.hpp"
+#include "scallop/geometry/surface.hpp"
 #ifdef SCALLOP_CONSUMER_CAD
-#include "scallop/cad_import.hpp"
+#include "scallop/cad/cad_import.hpp"
 #endif
 
 namespace {
