@@ -49,6 +49,7 @@
 #include "scallop/jobs/plan.hpp"
 #include "scallop/paths/scallop_hull.hpp"
 #include "scallop/geometry/surface.hpp"
+#include "scallop/io/surface_io.hpp"
 #include "scallop/paths/toolpath.hpp"
 #include "scallop/jobs/toolpath_job.hpp"
 #include "scallop/io/verify_output.hpp"

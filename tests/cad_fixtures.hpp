@@ -28,6 +28,7 @@
 
 #include "scallop/geometry/bezier.hpp"
 #include "scallop/geometry/surface.hpp"
+#include "scallop/io/surface_io.hpp"
 
 namespace scallop::test {
 

@@ -21,6 +21,7 @@
 #include "scallop/slicing/optimal_slicing.hpp"
 #include "scallop/slicing/stereographic.hpp"
 #include "scallop/geometry/surface.hpp"
+#include "scallop/io/surface_io.hpp"
 #include "corner_patches.hpp"
 #include "gauss_references.hpp"
 

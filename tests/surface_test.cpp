@@ -25,6 +25,7 @@
 #include "scallop/geometry/bezier.hpp"
 #include "scallop/error.hpp"
 #include "scallop/geometry/surface.hpp"
+#include "scallop/io/surface_io.hpp"
 
 namespace scallop {
 namespace {

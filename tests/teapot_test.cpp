@@ -22,6 +22,7 @@
 #include "scallop/error.hpp"
 #include "scallop/slicing/optimal_slicing.hpp"
 #include "scallop/geometry/surface.hpp"
+#include "scallop/io/surface_io.hpp"
 
 namespace scallop {
 namespace {

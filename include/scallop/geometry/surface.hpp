@@ -158,10 +158,6 @@ enum class SurfaceCheck {
 Surface parseSurface(std::string_view json, const std::string& sourceName,
                      SurfaceCheck check = SurfaceCheck::full);
 
-/// Reads, parses and validates a surface file ("-" reads standard input): .bpt text
-/// (surface_io.hpp, in inches) when the name ends in ".bpt", JSON when it ends in ".json",
-/// otherwise JSON if the text's first non-blank character is '{' and .bpt if not.
-Surface readSurface(const std::string& path, SurfaceCheck check = SurfaceCheck::full);
 
 /// The surface as JSON in the file format, one row of control points per line. Numbers are
 /// written shortest-round-trip (-0 as -0.0), so parseSurface(surfaceToJson(s)) reproduces

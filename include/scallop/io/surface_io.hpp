@@ -54,4 +54,9 @@ std::vector<std::size_t> parsePatchSelection(std::string_view selection, std::si
 /// scallop::Error for an index out of range. No validation.
 Surface selectPatches(const Surface& surface, std::span<const std::size_t> indices);
 
+/// Reads, parses and validates a surface file ("-" reads standard input): .bpt text
+/// (above, in inches) when the name ends in ".bpt", JSON when it ends in ".json",
+/// otherwise JSON if the text's first non-blank character is '{' and .bpt if not.
+Surface readSurface(const std::string& path, SurfaceCheck check = SurfaceCheck::full);
+
 }  // namespace scallop

@@ -6,7 +6,7 @@
 // Contract
 // --------
 // Input:  a valid Surface (surface.hpp) and the tool's moves as ball CENTRES (SweptMove):
-//         from a G-code program (gcode_reader.hpp; tip + R z) by sweptMoves(program, R), or
+//         from a G-code program (machine_program.hpp, read by gcode_reader.hpp; tip + R z) by sweptMoves(program, R), or
 //         from a ToolPath (toolpath.hpp) by sweptMoves(path). Lines (also zero-length and
 //         vertical), arcs in the three principal planes (quarter turns, full circles,
 //         helices); every coordinate finite. SimulationOptions as documented there.
@@ -127,7 +127,7 @@
 #include <vector>
 
 #include "scallop/paths/envelope.hpp"
-#include "scallop/io/gcode_reader.hpp"
+#include "scallop/paths/machine_program.hpp"
 #include "scallop/paths/gouge.hpp"
 #include "scallop/geometry/mesh.hpp"
 #include "scallop/geometry/surface.hpp"
