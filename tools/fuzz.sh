@@ -22,7 +22,7 @@ fi
 flags="-fsanitize=address,undefined,fuzzer-no-link -fno-sanitize-recover=undefined -fno-omit-frame-pointer -g"
 cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_C_COMPILER=clang-14 -DCMAKE_CXX_COMPILER=clang++-14 \
   -DCMAKE_CXX_FLAGS="$flags" -DSCALLOP_BUILD_CAD=OFF -DSCALLOP_BUILD_CLI=OFF -DSCALLOP_BUILD_TESTS=OFF \
-  -DSCALLOP_BUILD_BENCH=OFF -DSCALLOP_INSTALL=OFF -DSCALLOP_BUILD_FUZZERS=ON >/dev/null
+  -DSCALLOP_BUILD_BENCH=OFF -DSCALLOP_INSTALL=OFF -DSCALLOP_BUILD_PYTHON=OFF -DSCALLOP_BUILD_FUZZERS=ON >/dev/null
 cmake --build "$build" -j "${JOBS:-$(nproc)}"
 status=0
 for reader in chain surface stl gcode; do
