@@ -110,6 +110,36 @@ py::array_t<double> matrix(std::size_t rows, std::size_t columns) {
   return py::array_t<double>({static_cast<py::ssize_t>(rows), static_cast<py::ssize_t>(columns)});
 }
 
+// Elements with a start, an end and perhaps a centre in the xz-plane (hull elements, tool-path
+// elements) as an (k, 6) array: start (x, z), end (x, z), centre (x, z) or NaN where
+// hasCentre(element) is false.
+template <typename Element, typename HasCentre>
+py::array_t<double> xzRows(const std::vector<Element>& elements, HasCentre hasCentre) {
+  py::array_t<double> out = matrix(elements.size(), 6);
+  auto o = out.mutable_unchecked<2>();
+  for (std::size_t i = 0; i < elements.size(); ++i) {
+    const Element& e = elements[i];
+    const auto r = static_cast<py::ssize_t>(i);
+    const bool centre = hasCentre(e);
+    o(r, 0) = e.start.x;
+    o(r, 1) = e.start.z;
+    o(r, 2) = e.end.x;
+    o(r, 3) = e.end.z;
+    o(r, 4) = centre ? e.center.x : kNan;
+    o(r, 5) = centre ? e.center.z : kNan;
+  }
+  return out;
+}
+
+// flag(element) for each element, as a boolean array.
+template <typename Element, typename Flag>
+py::array_t<bool> flags(const std::vector<Element>& elements, Flag flag) {
+  py::array_t<bool> out(static_cast<py::ssize_t>(elements.size()));
+  auto o = out.mutable_unchecked<1>();
+  for (std::size_t i = 0; i < elements.size(); ++i) o(static_cast<py::ssize_t>(i)) = flag(elements[i]);
+  return out;
+}
+
 // ---- choices --------------------------------------------------------------------------
 
 scallop::Units parseUnits(const std::string& text) {
@@ -696,32 +726,16 @@ PYBIND11_MODULE(scallop, m) {
       .def_property_readonly(
           "elements",
           [](const Hull& h) {
-            const auto& hull = h.hull.hull;
-            py::array_t<double> out = matrix(hull.size(), 6);
-            auto o = out.mutable_unchecked<2>();
-            for (std::size_t i = 0; i < hull.size(); ++i) {
-              const scallop::HullElement& e = hull[i];
-              const auto r = static_cast<py::ssize_t>(i);
-              const bool centre = e.kind == scallop::HullElementKind::lid && !e.straight;
-              o(r, 0) = e.start.x;
-              o(r, 1) = e.start.z;
-              o(r, 2) = e.end.x;
-              o(r, 3) = e.end.z;
-              o(r, 4) = centre ? e.center.x : kNan;
-              o(r, 5) = centre ? e.center.z : kNan;
-            }
-            return out;
+            return xzRows(h.hull.hull, [](const scallop::HullElement& e) {
+              return e.kind == scallop::HullElementKind::lid && !e.straight;
+            });
           },
           "The hull's links and lids left to right, an (k, 6) array: start (x, z), end (x, z), a lid's circle "
           "centre (x, z) (NaN for links and for the straight lids of r = inf).")
       .def_property_readonly(
           "is_lid",
           [](const Hull& h) {
-            py::array_t<bool> out(static_cast<py::ssize_t>(h.hull.hull.size()));
-            auto o = out.mutable_unchecked<1>();
-            for (std::size_t i = 0; i < h.hull.hull.size(); ++i)
-              o(static_cast<py::ssize_t>(i)) = h.hull.hull[i].kind == scallop::HullElementKind::lid;
-            return out;
+            return flags(h.hull.hull, [](const scallop::HullElement& e) { return e.kind == scallop::HullElementKind::lid; });
           },
           "Per element: True for a lid (the circle over a deficiency), False for a link (on an edge).")
       .def_property_readonly(
@@ -740,32 +754,16 @@ PYBIND11_MODULE(scallop, m) {
       .def_property_readonly(
           "toolpath",
           [](const Hull& h) {
-            const auto& path = h.hull.toolpath;
-            py::array_t<double> out = matrix(path.size(), 6);
-            auto o = out.mutable_unchecked<2>();
-            for (std::size_t i = 0; i < path.size(); ++i) {
-              const scallop::PathElement& e = path[i];
-              const auto r = static_cast<py::ssize_t>(i);
-              const bool arc = e.kind == scallop::PathElementKind::arc;
-              o(r, 0) = e.start.x;
-              o(r, 1) = e.start.z;
-              o(r, 2) = e.end.x;
-              o(r, 3) = e.end.z;
-              o(r, 4) = arc ? e.center.x : kNan;
-              o(r, 5) = arc ? e.center.z : kNan;
-            }
-            return out;
+            return xzRows(h.hull.toolpath,
+                          [](const scallop::PathElement& e) { return e.kind == scallop::PathElementKind::arc; });
           },
           "The tool-centre path left to right, an (k, 6) array: start (x, z), end (x, z), an arc's centre (the "
           "chain vertex it rolls around; NaN for lines). Arcs are clockwise, of radius r. Empty for r = inf.")
       .def_property_readonly(
           "is_arc",
           [](const Hull& h) {
-            py::array_t<bool> out(static_cast<py::ssize_t>(h.hull.toolpath.size()));
-            auto o = out.mutable_unchecked<1>();
-            for (std::size_t i = 0; i < h.hull.toolpath.size(); ++i)
-              o(static_cast<py::ssize_t>(i)) = h.hull.toolpath[i].kind == scallop::PathElementKind::arc;
-            return out;
+            return flags(h.hull.toolpath,
+                         [](const scallop::PathElement& e) { return e.kind == scallop::PathElementKind::arc; });
           },
           "Per tool-path element: True for an arc, False for a line.")
       .def_property_readonly(
