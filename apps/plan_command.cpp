@@ -316,7 +316,7 @@ void runPlan(const PlanArguments& options) {
   JobControl control;
   if (!options.quiet)
     control.progress = [last = std::string()](double, const std::string& stage) mutable {
-      if (stage == last || stage == "done" || stage == "tool paths") return;  // a stage's advances; containers
+      if (stage == last || stage == "done") return;  // a stage's advances; the end
       last = stage;
       fmt::print(stderr, "scallop plan: {}...\n", stage);
     };

@@ -82,7 +82,7 @@ PlanResult plan(const Surface& surface, const PlanOptions& options, const JobCon
   }
   const OptimalSlicing& orientation = out.orientation;
   {
-    const ProgressStage stage(kOrientEnd, kPathsEnd, "tool paths");
+    const ProgressStage stage(kOrientEnd, kPathsEnd);  // its stages are toolpaths' own
     out.toolpaths = toolpaths(surface, job, orientation, control);
   }
   ToolpathResult& result = out.toolpaths;
