@@ -36,13 +36,16 @@ JobControlScope::JobControlScope(const JobControl* control, bool reportsProgress
       previousTo_(threadJob.to),
       previousLast_(threadJob.last),
       previousStage_(threadJob.stage) {
-  // The same control again (toolpaths inside plan): the caller's stage and scale go on.
+  // The same control again (toolpaths inside plan): the caller's stage, scale and progress go
+  // on, and nothing is restored at the end.
   if (control != nullptr && control == previousControl_ && reportsProgress == previousReports_) return;
+  installed_ = true;
   threadJob = ThreadJob{control, reportsProgress, 0.0, 1.0, 0.0, nullptr};
 }
 
 JobControlScope::~JobControlScope() {
-  threadJob = ThreadJob{previousControl_, previousReports_, previousFrom_, previousTo_, previousLast_, previousStage_};
+  if (installed_)
+    threadJob = ThreadJob{previousControl_, previousReports_, previousFrom_, previousTo_, previousLast_, previousStage_};
 }
 
 const JobControl* currentJobControl() noexcept { return threadJob.control; }

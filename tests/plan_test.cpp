@@ -253,6 +253,24 @@ TEST(JobControl, NestedStagesMapIntoTheirCallersRange) {
   }
   const std::vector<std::pair<double, std::string>> expected = {{0.5, "outer"}, {0.75, "inner"}, {0.875, "inner"}};
   EXPECT_EQ(events, expected);
+  // The same control installed again (a call nested in another): the caller's scale and
+  // progress go on, and survive the nested scope (progress never goes back after it).
+  {
+    std::vector<std::pair<double, std::string>> nestedEvents;
+    JobControl outerControl;
+    outerControl.progress = [&](double fraction, const std::string& stage) { nestedEvents.emplace_back(fraction, stage); };
+    const JobControlScope outerScope(&outerControl);
+    const ProgressStage first(0.0, 0.5, "first half");
+    {
+      const JobControlScope nested(&outerControl);
+      const ProgressStage inner(0.5, 1.0, "nested");  // [0.25, 0.5] of the whole
+      advanceStage(1, 1);                             // 0.5
+    }
+    advanceStage(1, 2);  // 0.25 < 0.5: not reported
+    const std::vector<std::pair<double, std::string>> expectedNested = {
+        {0.0, "first half"}, {0.25, "nested"}, {0.5, "nested"}};
+    EXPECT_EQ(nestedEvents, expectedNested);
+  }
   // A worker thread polls but never reports.
   std::thread worker([&] {
     const JobControlScope workerScope(&control, false);

@@ -78,6 +78,7 @@ class JobControlScope {
   bool previousReports_;
   double previousFrom_, previousTo_, previousLast_;
   const std::string* previousStage_;
+  bool installed_ = false;  ///< false: the control was there already (see above)
 };
 
 /// The control installed on this thread (null: none): what a parallel part hands its workers.
