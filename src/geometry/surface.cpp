@@ -989,6 +989,13 @@ double surfaceScale(const Surface& surface) {
   return scale;
 }
 
+double controlPointTop(const Surface& surface) {
+  double top = -std::numeric_limits<double>::infinity();
+  for (const BezierPatch& patch : surface.patches)
+    for (const Vec3& p : patch.control) top = std::max(top, p.z);
+  return top;
+}
+
 std::vector<std::string> exampleSurfaceNames() {
   return detail::exampleNames<Surface>(kExamples);
 }

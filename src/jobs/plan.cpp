@@ -1,9 +1,9 @@
 #include "scallop/jobs/plan.hpp"
 
 #include <algorithm>
-#include <chrono>
-#include <limits>
-#include <utility>
+#include <cmath>
+#include <string>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -23,13 +23,6 @@ constexpr int kRestRounds = 2;
 
 // The stages of plan, as parts of its [0, 1] (about their share of paper-1's plan time).
 constexpr double kOrientEnd = 0.01, kPathsEnd = 0.50, kGcodeEnd = 0.51, kSimulationEnd = 0.90;
-
-double highestControlPoint(const Surface& surface) {
-  double top = -std::numeric_limits<double>::infinity();
-  for (const BezierPatch& patch : surface.patches)
-    for (const Vec3& c : patch.control) top = std::max(top, c.z);
-  return top;
-}
 
 }  // namespace
 
@@ -59,13 +52,7 @@ PlanResult plan(const Surface& surface, const PlanOptions& options, const JobCon
     job.scallopHeight = options.scallopHeight.value_or(inch ? 0.001 : 0.025);
   }
   validateToolpathOptions(surface, job);
-  if (job.spacing) {
-    if (!(*job.spacing > 0.0) || !std::isfinite(*job.spacing))
-      throw Error(fmt::format("the spacing must be positive, got {}", *job.spacing));
-    flatCusp(job.toolRadius, *job.spacing);  // refused early from 2 R up
-  } else if (!(*job.scallopHeight > 0.0) || !std::isfinite(*job.scallopHeight)) {
-    throw Error(fmt::format("the scallop height must be positive, got {}", *job.scallopHeight));
-  }
+  if (job.spacing) flatCusp(job.toolRadius, *job.spacing);  // refused early from 2 R up
   job.link = options.link;
   job.dropEnvelope = options.dropEnvelope;
   job.constantSpacing = options.constantSpacing;
@@ -103,7 +90,7 @@ PlanResult plan(const Surface& surface, const PlanOptions& options, const JobCon
                                        2.0 * simulation.scallopHeight);
   // The finishing stock is the surface raised by the allowance everywhere: a flat top at the
   // part's highest point would clip it there (a flat part would show no scallop at all).
-  simulation.stockTop = highestControlPoint(surface) + *simulation.stockAllowance;
+  simulation.stockTop = controlPointTop(surface) + *simulation.stockAllowance;
   const auto writeAndSimulate = [&](double from, double to) {
     {
       const ProgressStage stage(from, from + 0.025 * (to - from), "writing the G-code");

@@ -272,6 +272,10 @@ void validateToolpathOptions(const Surface& surface, const ToolpathOptions& opti
                             source, options.toolRadius, size, unitsName(surface.units)));
   if (options.spacing.has_value() == options.scallopHeight.has_value())
     throw Error("give exactly one of --spacing and --scallop-height");
+  if (options.spacing && (!(*options.spacing > 0.0) || !std::isfinite(*options.spacing)))
+    throw Error(fmt::format("the spacing must be positive, got {}", *options.spacing));
+  if (options.scallopHeight && (!(*options.scallopHeight > 0.0) || !std::isfinite(*options.scallopHeight)))
+    throw Error(fmt::format("the scallop height must be positive, got {}", *options.scallopHeight));
   if (options.scallopHeight && !(*options.scallopHeight < options.toolRadius))
     throw Error(fmt::format("the scallop height {} must be smaller than the tool radius {}",
                             *options.scallopHeight, options.toolRadius));
@@ -320,10 +324,7 @@ void addPasses(const Surface& surface, const ToolpathOptions& options, const Too
 GcodeOptions defaultGcodeOptions(const Surface& surface, const ToolPath& path,
                                  GcodeDialect dialect, const std::string& title) {
   // The surface's control points bound it from above, so rapids at the safe height clear it.
-  double top = -std::numeric_limits<double>::infinity();
-  for (const BezierPatch& patch : surface.patches)
-    for (const Vec3& p : patch.control) top = std::max(top, p.z);
-  return defaultGcodeOptions(surface.units, top, path, dialect, title);
+  return defaultGcodeOptions(surface.units, controlPointTop(surface), path, dialect, title);
 }
 
 GcodeOptions defaultGcodeOptions(Units units, double partTop, const ToolPath& path, GcodeDialect dialect,

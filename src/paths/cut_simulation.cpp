@@ -786,10 +786,8 @@ void sweepAndCompare(SimulationReport& report, const std::vector<SweptMove>& mov
 SimulationReport simulateCut(const Surface& surface, const std::vector<SweptMove>& moves,
                              const SimulationOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  double top = -kInf;
-  for (const BezierPatch& patch : surface.patches)
-    for (const Vec3& c : patch.control) top = std::max(top, c.z);
-  SimulationReport report = reportFor(surface.units, simulationGrid(surface, options), top, options);
+  SimulationReport report =
+      reportFor(surface.units, simulationGrid(surface, options), controlPointTop(surface), options);
   designHeights(surface, report.design, &report.designNormalZ);
   report.designSeconds = secondsSince(start);
   const double radius = options.toolRadius, height = options.scallopHeight;

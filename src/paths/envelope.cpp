@@ -114,10 +114,7 @@ double localDropHeight(const BezierPatch& patch, double& u, double& v, double X,
 // Above every control point by R: every surface point is at least R below a ball centre
 // there, so at least R away. A relative hair more for the rounding of the comparison.
 double ballTop(const Surface& surface, double radius) {
-  double top = -kInfinity;
-  for (const BezierPatch& patch : surface.patches) {
-    for (const Vec3& p : patch.control) top = std::max(top, p.z);
-  }
+  const double top = controlPointTop(surface);
   return top + radius * (1.0 + 1e-9) + 1e-9 * std::abs(top);
 }
 

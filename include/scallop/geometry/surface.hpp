@@ -267,6 +267,10 @@ Surface trimmedPieces(const Surface& surface, const TrimSplitOptions& options = 
 /// for tolerances.
 double surfaceScale(const Surface& surface);
 
+/// The highest z of all control points (-inf for no patches): the convex-hull property makes
+/// it an upper bound of the surface (safe heights, the stock's top).
+double controlPointTop(const Surface& surface);
+
 /// Names of the built-in example surfaces, and one of them by name (throws on an unknown
 /// name). All are in inches. The bicubic test surfaces of the paper's Section 4, on a
 /// 3 x 3 inch footprint with p_jk = (k, j, z_jk):

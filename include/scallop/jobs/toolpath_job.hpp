@@ -65,7 +65,8 @@ struct ToolpathResult {
 };
 
 /// The checks toolpaths makes before any work: a positive finite tool radius at most 1000 times
-/// the surface's size, exactly one of spacing and scallop height, H < R. scallop::Error.
+/// the surface's size, exactly one of spacing and scallop height, positive and finite, H < R.
+/// scallop::Error.
 void validateToolpathOptions(const Surface& surface, const ToolpathOptions& options);
 
 /// Computes the tool path (see the contract); `orientation`, when given, is reused as N*.
