@@ -185,7 +185,7 @@ struct BestCircles {
   /// full-resolution domain was searched (small domain, coarseToFine off, or a fallback).
   double simplificationTolerance = 0.0;
   /// Edges of `axis` rated at their ends alone: an upper bound of alpha over the edge (from
-  /// its control points, see optimal_slicing.cpp) fell short of the best end less the
+  /// its control points, see circle_search.cpp) fell short of the best end less the
   /// window, so no root of eq (13) on it could be the best or a rival.
   std::size_t boundedEdges = 0;
 };
