@@ -15,6 +15,7 @@
 #include <set>
 #include <tuple>
 #include <unordered_map>
+#include <utility>
 #include <clipper.hpp>
 #include <fmt/format.h>
 
@@ -1227,15 +1228,10 @@ IntLoops mergeSheet(const IntLoops& cells) {
   return out;
 }
 
-}  // namespace
+// ---------------------------------------------------------------------------------------
+// symmetrizedGaussMap's stages, in the order it runs them.
 
-bool isSymmetrizedNormal(const Surface& surface, const Vec3& direction) {
-  std::vector<PatchData> patches;
-  for (const BezierPatch& p : cornerResolved(surface).patches) patches.push_back(makePatchData(p));
-  return inOmega(patches, normalized(direction));
-}
-
-GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& options) {
+void validateOptions(const GaussMapOptions& options) {
   const double tol = options.toleranceRad;
   if (!(tol > 0.0) || !std::isfinite(tol)) {
     throw Error(fmt::format("the Gauss map tolerance must be a positive angle, got {} rad", tol));
@@ -1250,53 +1246,36 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
     throw Error(fmt::format("the Gauss map's deepest quadtree level must be 1 .. 40, got {}",
                             options.maxCellDepth));
   }
-  if (surface.patches.empty()) throw Error("the surface has no patches");
-  GaussMap map;
-  std::vector<PatchData> patches;
-  // Corners where q vanishes are blown up into fans (surface.hpp's cornerPieces): their ray
-  // limits become an apex row's curve, a boundary like any other.
-  std::vector<std::size_t> sources;
-  const Surface resolved = cornerResolved(surface, &sources);
-  for (std::size_t i = 0; i < resolved.patches.size(); ++i) {
-    patches.push_back(makePatchData(resolved.patches[i]));
-    patches.back().index = sources[i];
-  }
-  // Errors from one patch's quadtree or sampling name the patch.
-  auto inPatch = [](const PatchData& data, const auto& work) {
-    try {
-      work();
-    } catch (const Cancelled&) {
-      throw;
-    } catch (const Error& e) {
-      throw Error(fmt::format("patches[{}]: {}", data.index, e.what()));
-    }
-  };
-  markSeams(patches);
+}
 
-  // At fine tolerances, a coarse map first: curves farther than a band around its boundary
-  // lie deep inside Omega, and their polygons need only its tolerance (see BoundaryBand and
-  // the contract). Pieces on seams are exempt: two patches' polygons of one curve, each
-  // within its own tolerance, leave a sliver between them that would be a gap in Omega.
-  std::optional<BoundaryBand> band;
-  if (options.coarseBand && kCoarseBandFactor * tol <= kCoarseToleranceRad) {
-    GaussMapOptions coarseOptions = options;
-    coarseOptions.toleranceRad = kCoarseToleranceRad;
-    const GaussMap coarse = symmetrizedGaussMap(surface, coarseOptions);
-    if (coarse.kind == GaussMapKind::region) {
-      band.emplace(coarse.sphereCurves, kBandWidthTolerances * kCoarseToleranceRad);
-    }
+// Runs one patch's quadtree or sampling; its errors name the patch.
+template <typename Work>
+void inPatch(const PatchData& data, const Work& work) {
+  try {
+    work();
+  } catch (const Cancelled&) {
+    throw;
+  } catch (const Error& e) {
+    throw Error(fmt::format("patches[{}]: {}", data.index, e.what()));
   }
+}
 
-  // The cells of every curved patch (a developable patch has no regular cell: its image is
-  // the image of its boundary, a curve).
+// The cells of every curved patch, and the patches whose image is a curve (a developable
+// patch has no regular cell: its image is the image of its boundary).
+struct PatchCells {
   std::vector<CellBuilder> builders;
   std::vector<const PatchData*> developablePatches;
+};
+
+PatchCells buildPatchCells(const std::vector<PatchData>& patches, double tol, int maxCellDepth) {
+  PatchCells out;
+  std::vector<CellBuilder>& builders = out.builders;
   for (const PatchData& data : patches) {
     if (data.developable) {
-      developablePatches.push_back(&data);
+      out.developablePatches.push_back(&data);
       continue;
     }
-    builders.push_back(CellBuilder{data, tol, options.maxCellDepth, {}, nullptr, {}});
+    builders.push_back(CellBuilder{data, tol, maxCellDepth, {}, nullptr, {}});
     inPatch(data, [&] { builders.back().run(); });
     // A curved patch whose normals stay within the tolerance (its whole domain one small
     // fold cell: no regular cell, nothing to trace; K of rounding size and both signs, as
@@ -1312,17 +1291,24 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
     });
     if (tiny) {
       builders.pop_back();
-      developablePatches.push_back(&data);
+      out.developablePatches.push_back(&data);
     }
   }
-  const bool allDevelopable = builders.empty();
+  return out;
+}
 
-  // The pole cell: the regular cell of largest parameter area (the first such, in patch
-  // order); the pole is its centre normal, inside its image, so that image is the outside of
-  // its boundary's projection. It is chosen before any edge is sampled because the sampling
-  // measures the polygon in the pole frame's plane (see NormalSampler). Without a regular
-  // cell the frame's pole is a normal of the first patch.
-  const Vec3 first = unitNormal(surface.patches.front(), 0.5, 0.5);
+// The pole cell: builders[builder].cells[index]; builder == builders.size() when there is
+// no regular cell.
+struct PoleCell {
+  std::size_t builder = 0;
+  std::size_t index = 0;
+};
+
+// The regular cell of largest parameter area (the first such, in patch order); the pole is
+// its centre normal, inside its image, so that image is the outside of its boundary's
+// projection. It is chosen before any edge is sampled because the sampling measures the
+// polygon in the pole frame's plane (see NormalSampler).
+PoleCell choosePoleCell(std::vector<CellBuilder>& builders, double tol) {
   std::size_t poleBuilder = builders.size(), poleIndex = 0;
   double poleArea = 0.0;
   // Without a regular cell (a patch whose normals vary little, crossed by one parabolic
@@ -1362,44 +1348,51 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
     builder.cells.clear();
     inPatch(builder.data, [&] { builder.run(); });
   }
-  // The pole is the cell's centre normal, or with options.offsetPole the normal at a point
-  // with irrational-looking offsets: a dyadic centre's normal can be exactly the normal at a
-  // point of another cell's (dyadic) edge on surfaces with symmetries (a surface of
-  // revolution repeats its normals' latitudes along every meridian). The pole on an edge's
-  // image puts that edge's polygon through the projection's point at infinity (the teapot's
-  // lower body lost its whole complement so); optimalSlicing retries with the offset pole
-  // when the complement comes out empty.
-  if (poleBuilder < builders.size()) {
-    const Cell& c = builders[poleBuilder].cells[poleIndex];
-    const double poleOffsetU = options.offsetPole ? 0.4142135623730950 : 0.5;  // sqrt(2) - 1
-    const double poleOffsetV = options.offsetPole ? 0.5811388300841898 : 0.5;  // sqrt(10)/2 - 1
-    map.pole = unitNormal(*builders[poleBuilder].data.patch, c.u0 + poleOffsetU * (c.u1 - c.u0),
-                          c.v0 + poleOffsetV * (c.v1 - c.v0));
-  } else {
-    map.pole = first;
-  }
-  map.toPoleFrame = rotationTaking(map.pole, {0.0, 0.0, 1.0});
+  return {poleBuilder, poleIndex};
+}
 
-  const NormalSampler sampler{tol, map.toPoleFrame};
-  NormalSampler inner = sampler;  // for curves off the seams (see BoundaryBand)
-  if (band) inner.band = &*band, inner.coarseTol = kCoarseToleranceRad;
+// The pole is the cell's centre normal, or with options.offsetPole the normal at a point
+// with irrational-looking offsets: a dyadic centre's normal can be exactly the normal at a
+// point of another cell's (dyadic) edge on surfaces with symmetries (a surface of
+// revolution repeats its normals' latitudes along every meridian). The pole on an edge's
+// image puts that edge's polygon through the projection's point at infinity (the teapot's
+// lower body lost its whole complement so); optimalSlicing retries with the offset pole
+// when the complement comes out empty. Without a regular cell the frame's pole is
+// `fallback`, a normal of the first patch.
+Vec3 poleNormal(const std::vector<CellBuilder>& builders, PoleCell pole, bool offsetPole,
+                const Vec3& fallback) {
+  if (pole.builder == builders.size()) return fallback;
+  const Cell& c = builders[pole.builder].cells[pole.index];
+  const double poleOffsetU = offsetPole ? 0.4142135623730950 : 0.5;  // sqrt(2) - 1
+  const double poleOffsetV = offsetPole ? 0.5811388300841898 : 0.5;  // sqrt(10)/2 - 1
+  return unitNormal(*builders[pole.builder].data.patch, c.u0 + poleOffsetU * (c.u1 - c.u0),
+                    c.v0 + poleOffsetV * (c.v1 - c.v0));
+}
 
-  // Cell images of every curved patch; the images of the developable patches' boundaries.
-  // A patch is run again, with cells subdivided instead of traced, while some traced cell
-  // holds +-pole (its part would be the outside of its loop, as for the cells handled by
-  // insertOutside below, for which only a small cell's hull can stand) or whose edges did not
-  // show two crossings. Regular cells come out the same, the pole cell among them.
+// The cell images of every curved patch, the pole cell's index among them, and counts.
+struct CurvedImages {
   std::vector<CellImage> cells;
   std::size_t poleCell = 0;
-  CellBuilder::ImageStats imageStats;
+  CellBuilder::ImageStats stats;
   std::size_t foldCells = 0;
+};
+
+// A patch is run again, with cells subdivided instead of traced, while some traced cell
+// holds +-pole (its part would be the outside of its loop, as for the cells handled by
+// insertOutside in OmegaPieces, for which only a small cell's hull can stand) or whose edges
+// did not show two crossings. Regular cells come out the same, the pole cell among them.
+// `pole` must outlive the builders' use (they keep its address).
+CurvedImages imagesOfCurvedPatches(std::vector<CellBuilder>& builders, PoleCell poleCell,
+                                   const Vec3& pole, const NormalSampler& sampler,
+                                   const NormalSampler& inner) {
+  CurvedImages out;
   for (std::size_t b = 0; b < builders.size(); ++b) {
     CellBuilder& builder = builders[b];
     const CellBuilder::CellBounds poleBounds =
-        b == poleBuilder ? CellBuilder::boundsOf(builder.cells[poleIndex]) : CellBuilder::CellBounds{};
-    builder.avoid = &map.pole;
+        b == poleCell.builder ? CellBuilder::boundsOf(builder.cells[poleCell.index]) : CellBuilder::CellBounds{};
+    builder.avoid = &pole;
     bool rerun = std::any_of(builder.cells.begin(), builder.cells.end(), [&](const Cell& c) {
-      return c.traceAxis != 0 && builder.holdsEither(c, map.pole);
+      return c.traceAxis != 0 && builder.holdsEither(c, pole);
     });
     std::vector<CellImage> images;
     CellBuilder::ImageStats stats;
@@ -1413,82 +1406,65 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
         stats = {};
         images = builder.images(sampler, inner, stats, untraceable);
       });
-      imageStats.untracedCells += untraceable.size();  // over every run
+      out.stats.untracedCells += untraceable.size();  // over every run
       if (untraceable.empty()) break;
       builder.noTrace.insert(untraceable.begin(), untraceable.end());
       rerun = true;
     }
-    if (b == poleBuilder) {
+    if (b == poleCell.builder) {
       for (std::size_t i = 0; i < builder.cells.size(); ++i) {
-        if (!builder.cells[i].fold && CellBuilder::boundsOf(builder.cells[i]) == poleBounds) poleCell = cells.size() + i;
+        if (!builder.cells[i].fold && CellBuilder::boundsOf(builder.cells[i]) == poleBounds) out.poleCell = out.cells.size() + i;
       }
     }
-    imageStats.parabolicLines += stats.parabolicLines;
-    imageStats.tracedCells += stats.tracedCells;
-    for (const Cell& c : builder.cells) foldCells += c.fold && c.traceAxis == 0 ? 1 : 0;
-    for (auto& c : images) cells.push_back(std::move(c));
+    out.stats.parabolicLines += stats.parabolicLines;
+    out.stats.tracedCells += stats.tracedCells;
+    for (const Cell& c : builder.cells) out.foldCells += c.fold && c.traceAxis == 0 ? 1 : 0;
+    for (auto& c : images) out.cells.push_back(std::move(c));
   }
-  // Among curved patches a developable patch's curve is thickened into a strip of half-width
-  // tol / 2 around a polygon sampled to tol / 2 (see thinStrip below): sampled to tol alone,
-  // it is the image itself.
-  const NormalSampler curveSampler{allDevelopable ? tol : 0.5 * tol, map.toPoleFrame};
-  std::vector<std::vector<Vec3>> developableCurves;
-  for (const PatchData* data : developablePatches) {
+  return out;
+}
+
+// The images of the developable patches' boundaries: four curves per patch.
+std::vector<std::vector<Vec3>> developableCurves(const std::vector<const PatchData*>& patches,
+                                                 const NormalSampler& curveSampler) {
+  std::vector<std::vector<Vec3>> curves;
+  for (const PatchData* data : patches) {
     const BezierPatch& patch = *data->patch;
     const std::array<std::function<Vec3(double)>, 4> edges{
         [&](double s) { return unitNormal(patch, s, 0.0); },
         [&](double s) { return unitNormal(patch, 1.0, s); },
         [&](double s) { return unitNormal(patch, 1.0 - s, 1.0); },
         [&](double s) { return unitNormal(patch, 0.0, 1.0 - s); }};
-    for (const auto& edge : edges) developableCurves.push_back(curveSampler.curve(edge));
+    for (const auto& edge : edges) curves.push_back(curveSampler.curve(edge));
   }
+  return curves;
+}
 
-  // All normals within the tolerance of one direction: a plane.
+// The largest angle from `first` to any sampled normal.
+double spreadAbout(const Vec3& first, const std::vector<CellImage>& cells,
+                   const std::vector<std::vector<Vec3>>& curves) {
   double spread = 0.0;
   for (const CellImage& c : cells) {
     for (const Vec3& n : c.normals) spread = std::max(spread, angleBetween(first, n));
   }
-  for (const auto& curve : developableCurves) {
+  for (const auto& curve : curves) {
     for (const Vec3& n : curve) spread = std::max(spread, angleBetween(first, n));
   }
-  auto asPoint = [&] {
-    map.kind = GaussMapKind::point;
-    map.pole = first;
-    map.toPoleFrame = rotationTaking(first, {0.0, 0.0, 1.0});
-    map.sphereCurves = {{first}, {-first}};
-    return map;
-  };
-  if (spread <= tol) return asPoint();
-  if (allDevelopable) {
-    map.kind = GaussMapKind::curve;
-    for (const auto& curve : developableCurves) {
-      map.sphereCurves.push_back(curve);
-      std::vector<Vec3> opposite;
-      for (const Vec3& n : curve) opposite.push_back(-n);
-      map.sphereCurves.push_back(std::move(opposite));
-    }
-    return map;
-  }
-  if (poleBuilder == builders.size()) throw Error("the Gauss map has no regular cell (K = 0 almost everywhere)");
-  const Rotation3 back = transpose(map.toPoleFrame);
+  return spread;
+}
 
-  auto project = [&](const Vec3& n) { return stereographic(apply(map.toPoleFrame, n)); };
-  // The pole cell's boundary bounds everything else: scale it into the integer grid.
-  std::vector<Vec2> outer;
-  for (const Vec3& n : cells[poleCell].normals) outer.push_back(project(n));
-  double extent = 0.0;
-  for (const Vec2& p : outer) extent = std::max({extent, std::abs(p.x), std::abs(p.y)});
-  const double scale = static_cast<double>(1 << 29) / extent;
-  // A map too small for the grid: the antipodal image lies about the origin, where a grid
-  // step of extent / 2^29 spans two steps' angle, while the pole cell's image reaches out
-  // to ~2 / (its angular radius). With the normals' spread under 32 steps (2^-24 extent) the
-  // antipodal image would collapse to a few grid points (a nearly flat surface: 1 mm of twist
-  // over 10 km): the map is reported as a point, like a plane's, and optimalSlicing measures
-  // alpha on the surface itself.
-  if (spread <= 0x1p-24 * extent) return asPoint();
-  auto toInt = [&](const Vec2& p) {
+// The stereographic plane of the pole frame, and Clipper's integer grid on it.
+struct PlaneGrid {
+  Rotation3 toPoleFrame;
+  double scale = 1.0;   // grid steps per unit of the plane
+  double window = 0.0;  // half-width of the square every polygon is clipped to (plane units)
+
+  [[nodiscard]] Vec2 project(const Vec3& n) const { return stereographic(apply(toPoleFrame, n)); }
+
+  [[nodiscard]] IntPoint toInt(const Vec2& p) const {
     return IntPoint(std::llround(p.x * scale), std::llround(p.y * scale));
-  };
+  }
+
   // Everything outside the pole cell's loop is in Omega, so only a cell image's part inside
   // a square around that loop matters: each polygon is clipped to the square of (2 - 2^-28)
   // times the loop's extent (coordinates at most 2^30 - 2 on the grid, where Clipper's
@@ -1497,8 +1473,7 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
   // whose image comes close to the pole (far out in the plane) but does not hold it would
   // otherwise be folded over, and mergeSheet, which sums each sheet's cells as oriented
   // chains, would subtract it from its neighbours' region, leaving a hole in Omega.
-  const double window = (2.0 - 0x1p-28) * extent;
-  auto toPolygon = [&](const std::vector<Vec2>& loop) {
+  [[nodiscard]] IntLoop toPolygon(const std::vector<Vec2>& loop) const {
     IntLoop points;
     for (const Vec2& p : clipToSquare(loop, window)) {
       const IntPoint ip = toInt(p);
@@ -1506,160 +1481,193 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
     }
     while (points.size() > 1 && points.front() == points.back()) points.pop_back();
     return points;
-  };
-  // A simple loop (a hull, a strip, a cell's boundary) turned counter-clockwise: Omega is
-  // formed with the positive fill rule, every region winding +1 around its points.
-  auto counterClockwise = [](IntLoop loop) {
-    if (signedArea2(loop) < 0.0) std::reverse(loop.begin(), loop.end());
-    return loop;
-  };
-  // One Clipper operation; its own exceptions (a coordinate out of range, which the window
-  // rules out) and failures become the project's.
-  auto run = [](ClipperLib::ClipType type, const IntLoops& subject, const IntLoops& clip,
-                ClipperLib::PolyFillType subjectFill, ClipperLib::PolyFillType clipFill) {
-    IntLoops result;  // outlines counter-clockwise, holes clockwise
-    bool done = false;
-    try {
-      ClipperLib::Clipper clipper;
-      const bool anySubject = clipper.AddPaths(subject, ClipperLib::ptSubject, true);
-      const bool anyClip = clipper.AddPaths(clip, ClipperLib::ptClip, true);
-      // No edge at all (a sheet whose cells all cancel or collapse on the grid): the result is
-      // empty, and Execute would report a failure.
-      if (!anySubject && !anyClip) return result;
-      done = clipper.Execute(type, result, subjectFill, clipFill);
-    } catch (const ClipperLib::clipperException& e) {
-      throw Error(fmt::format("the Gauss map's polygon union failed: {}", e.what()));
-    }
-    if (!done) throw Error("the Gauss map's polygon union failed (Clipper's Execute)");
-    return result;
-  };
+  }
 
-  const IntLoop outerLoop = counterClockwise(toPolygon(outer));
-  // Omega's pieces, each winding +1 around its points (overlaps add up); united at the end.
-  // A piece is one or more loops (a union's outlines with their holes, which wind -1 and
-  // must stay with them).
-  std::vector<IntLoops> omega;
-  auto add = [&](IntLoops pieces) { omega.push_back(std::move(pieces)); };
-  // An image that holds the pole is the outside of its projected loop (within the window).
-  const auto insertOutside = [&](const std::vector<Vec2>& loop) {
-    add(run(ClipperLib::ctDifference, {outerLoop}, {counterClockwise(toPolygon(loop))},
-            ClipperLib::pftPositive, ClipperLib::pftPositive));
-  };
-  // Regular cells of one patch with one sign of K map with one orientation and share their
-  // image vertices exactly with their neighbours (see CellBuilder): their union is the chain
-  // left when every edge shared by two of them (traversed once each way) cancels. Handing
-  // Clipper those few loops instead of thousands of cells makes the union cheap.
-  std::map<std::tuple<const PatchData*, int, int>, IntLoops> sheets;
-  // A loop of normals (for n, or -n) into its sheet. The Gauss map keeps the orientation of
-  // (u, v) where K > 0 (n = r_u x r_v) and reverses it where K < 0; the antipodal map and
-  // the stereographic projection from the north pole each reverse it: a part
-  // (counter-clockwise in (u, v)) maps to a polygon of orientation -sign(K) for n and
-  // sign(K) for -n.
-  const auto addToSheet = [&](const CellImage& c, const std::vector<Vec3>& normals,
-                              int curvatureSign, double sign) {
+  [[nodiscard]] std::vector<Vec2> toLoop(const IntLoop& contour) const {
     std::vector<Vec2> loop;
-    loop.reserve(normals.size());
-    for (const Vec3& n : normals) loop.push_back(project(sign * n));
-    sheets[{c.patch, curvatureSign, sign > 0.0 ? 1 : -1}].push_back(toPolygon(loop));
-  };
-  for (std::size_t i = 0; i < cells.size(); ++i) {
-    const CellImage& c = cells[i];
-    for (double sign : {1.0, -1.0}) {
-      if (i == poleCell && sign > 0.0) continue;
-      // A cell whose image holds the pole (the Gauss map covers the pole more than once) is
-      // the outside of its projected boundary: within the pole cell's loop, that loop's
-      // region minus the cell loop's inside (decided in CellBuilder::images).
-      const bool holdsPole = c.holdsPole[sign > 0.0 ? 0 : 1];
-      if (!holdsPole && !c.fold) {
-        addToSheet(c, c.normals, c.curvatureSign, sign);  // merged below
-        continue;
-      }
-      if (!holdsPole && !c.parts.empty()) {
-        for (const SheetPart& part : c.parts) addToSheet(c, part.normals, part.curvatureSign, sign);
-        continue;
-      }
+    loop.reserve(contour.size());
+    for (const IntPoint& p : contour) loop.push_back({static_cast<double>(p.X) / scale, static_cast<double>(p.Y) / scale});
+    return loop;
+  }
+};
+
+// A simple loop (a hull, a strip, a cell's boundary) turned counter-clockwise: Omega is
+// formed with the positive fill rule, every region winding +1 around its points.
+IntLoop counterClockwise(IntLoop loop) {
+  if (signedArea2(loop) < 0.0) std::reverse(loop.begin(), loop.end());
+  return loop;
+}
+
+// One Clipper operation; its own exceptions (a coordinate out of range, which the window
+// rules out) and failures become the project's.
+IntLoops clip(ClipperLib::ClipType type, const IntLoops& subject, const IntLoops& clipLoops,
+              ClipperLib::PolyFillType subjectFill, ClipperLib::PolyFillType clipFill) {
+  IntLoops result;  // outlines counter-clockwise, holes clockwise
+  bool done = false;
+  try {
+    ClipperLib::Clipper clipper;
+    const bool anySubject = clipper.AddPaths(subject, ClipperLib::ptSubject, true);
+    const bool anyClip = clipper.AddPaths(clipLoops, ClipperLib::ptClip, true);
+    // No edge at all (a sheet whose cells all cancel or collapse on the grid): the result is
+    // empty, and Execute would report a failure.
+    if (!anySubject && !anyClip) return result;
+    done = clipper.Execute(type, result, subjectFill, clipFill);
+  } catch (const ClipperLib::clipperException& e) {
+    throw Error(fmt::format("the Gauss map's polygon union failed: {}", e.what()));
+  }
+  if (!done) throw Error("the Gauss map's polygon union failed (Clipper's Execute)");
+  return result;
+}
+
+// Omega's pieces in the plane, each winding +1 around its points (overlaps add up), to be
+// united at the end. A piece is one or more loops (a union's outlines with their holes,
+// which wind -1 and must stay with them).
+class OmegaPieces {
+ public:
+  OmegaPieces(const PlaneGrid& grid, IntLoop outerLoop) : grid_(grid), outerLoop_(std::move(outerLoop)) {}
+
+  // The images of the curved patches' cells, +-n, all but the pole cell's +n.
+  void addCells(const std::vector<CellImage>& cells, std::size_t poleCell) {
+    // Regular cells of one patch with one sign of K map with one orientation and share their
+    // image vertices exactly with their neighbours (see CellBuilder): their union is the chain
+    // left when every edge shared by two of them (traversed once each way) cancels. Handing
+    // Clipper those few loops instead of thousands of cells makes the union cheap.
+    std::map<std::tuple<const PatchData*, int, int>, IntLoops> sheets;
+    // A loop of normals (for n, or -n) into its sheet. The Gauss map keeps the orientation of
+    // (u, v) where K > 0 (n = r_u x r_v) and reverses it where K < 0; the antipodal map and
+    // the stereographic projection from the north pole each reverse it: a part
+    // (counter-clockwise in (u, v)) maps to a polygon of orientation -sign(K) for n and
+    // sign(K) for -n.
+    const auto addToSheet = [&](const CellImage& c, const std::vector<Vec3>& normals,
+                                int curvatureSign, double sign) {
       std::vector<Vec2> loop;
-      for (const Vec3& n : c.normals) loop.push_back(project(sign * n));
-      if (c.fold) loop = convexHull(std::move(loop));
-      if (loop.size() < 3) continue;
-      if (holdsPole) {
-        insertOutside(loop);
-      } else {
-        // Collected only: the union is formed once, by the final difference.
-        omega.push_back({counterClockwise(toPolygon(loop))});
+      loop.reserve(normals.size());
+      for (const Vec3& n : normals) loop.push_back(grid_.project(sign * n));
+      sheets[{c.patch, curvatureSign, sign > 0.0 ? 1 : -1}].push_back(grid_.toPolygon(loop));
+    };
+    for (std::size_t i = 0; i < cells.size(); ++i) {
+      const CellImage& c = cells[i];
+      for (double sign : {1.0, -1.0}) {
+        if (i == poleCell && sign > 0.0) continue;
+        // A cell whose image holds the pole (the Gauss map covers the pole more than once) is
+        // the outside of its projected boundary: within the pole cell's loop, that loop's
+        // region minus the cell loop's inside (decided in CellBuilder::images).
+        const bool holdsPole = c.holdsPole[sign > 0.0 ? 0 : 1];
+        if (!holdsPole && !c.fold) {
+          addToSheet(c, c.normals, c.curvatureSign, sign);  // merged below
+          continue;
+        }
+        if (!holdsPole && !c.parts.empty()) {
+          for (const SheetPart& part : c.parts) addToSheet(c, part.normals, part.curvatureSign, sign);
+          continue;
+        }
+        std::vector<Vec2> loop;
+        for (const Vec3& n : c.normals) loop.push_back(grid_.project(sign * n));
+        if (c.fold) loop = convexHull(std::move(loop));
+        if (loop.size() < 3) continue;
+        if (holdsPole) {
+          insertOutside(loop);
+        } else {
+          // Collected only: the union is formed once, by the final difference.
+          pieces_.push_back({counterClockwise(grid_.toPolygon(loop))});
+        }
       }
     }
+    // Each sheet joins the union as the region where its merged loops wind either way
+    // (nonzero), formed on its own: the union sums windings, and one sheet's must not cancel
+    // another's. Beside a parabolic line a sheet can be thinner than the tolerance: a crescent
+    // between the fold's image and a patch edge's, tangent where they meet, or a spike where
+    // the line runs close to a patch edge. The polygons of the two curves, each within the
+    // tolerance of its curve, may then cross, and the lobes they cut off wind the wrong way.
+    // Outside the tolerance of the sheet's boundary curves the polygon's winding number is
+    // the curves' (the polygon is homotopic to them within that band), so the nonzero region
+    // differs from the true image only within the tolerance of those curves, all of which
+    // are normals: Omega's boundary stays within the tolerance, and no normal is cancelled.
+    for (const auto& [unused, polygons] : sheets) {
+      pieces_.push_back(clip(ClipperLib::ctUnion, mergeSheet(polygons), {}, ClipperLib::pftNonZero,
+                             ClipperLib::pftNonZero));
+    }
   }
-  // Each sheet joins the union as the region where its merged loops wind either way
-  // (nonzero), formed on its own: the union sums windings, and one sheet's must not cancel
-  // another's. Beside a parabolic line a sheet can be thinner than the tolerance: a crescent
-  // between the fold's image and a patch edge's, tangent where they meet, or a spike where
-  // the line runs close to a patch edge. The polygons of the two curves, each within the
-  // tolerance of its curve, may then cross, and the lobes they cut off wind the wrong way.
-  // Outside the tolerance of the sheet's boundary curves the polygon's winding number is
-  // the curves' (the polygon is homotopic to them within that band), so the nonzero region
-  // differs from the true image only within the tolerance of those curves, all of which
-  // are normals: Omega's boundary stays within the tolerance, and no normal is cancelled.
-  for (const auto& [unused, polygons] : sheets) {
-    add(run(ClipperLib::ctUnion, mergeSheet(polygons), {}, ClipperLib::pftNonZero, ClipperLib::pftNonZero));
-  }
+
   // A developable patch among curved ones: its normals form a curve (or a point) that may
   // lie outside the curved patches' region, and they are obstacles for the slicing
   // direction like any other normal, so the medial axis must see them. A curve has no
   // interior for the even-odd loops to bound: it enters Omega as strips of half-width tol / 2
   // around its polygon, sampled to tol / 2, so that Omega holds the whole curve and its
   // boundary stays within tol of it.
-  for (const auto& curve : developableCurves) {
-    for (double sign : {1.0, -1.0}) {
-      // Each segment of the polygon (a curve has at least its two ends; a plane's are
-      // equal, and its strip is a disk).
-      const std::size_t segments = std::max<std::size_t>(curve.size(), 2) - 1;
-      for (std::size_t i = 0; i < segments; ++i) {
-        const Vec3 a = sign * curve[i];
-        const Vec3 b = sign * curve[std::min(i + 1, curve.size() - 1)];
-        ThinStrip strip = thinStrip(a, b, 0.5 * tol);
-        // Whether the strip holds the pole, decided with a margin either side of its
-        // polygon's chords (at halfWidth) and vertices (at reach): a strip passing the pole
-        // in between is widened until it clearly holds it.
-        const double gap = angleToArc(map.pole, a, b);
-        if (gap > 0.45 * tol && gap <= 1.01 * strip.reach) strip = thinStrip(a, b, 2.0 * gap);
-        std::vector<Vec2> loop;
-        for (const Vec3& n : strip.loop) loop.push_back(project(n));
-        if (gap <= 1.01 * strip.reach) {
-          // The strip's image is the outside of its projected loop (as for a cell holding
-          // the pole, above).
-          insertOutside(loop);
-        } else {
-          omega.push_back({counterClockwise(toPolygon(loop))});
+  void addCurves(const std::vector<std::vector<Vec3>>& curves, const Vec3& pole, double tol) {
+    for (const auto& curve : curves) {
+      for (double sign : {1.0, -1.0}) {
+        // Each segment of the polygon (a curve has at least its two ends; a plane's are
+        // equal, and its strip is a disk).
+        const std::size_t segments = std::max<std::size_t>(curve.size(), 2) - 1;
+        for (std::size_t i = 0; i < segments; ++i) {
+          const Vec3 a = sign * curve[i];
+          const Vec3 b = sign * curve[std::min(i + 1, curve.size() - 1)];
+          ThinStrip strip = thinStrip(a, b, 0.5 * tol);
+          // Whether the strip holds the pole, decided with a margin either side of its
+          // polygon's chords (at halfWidth) and vertices (at reach): a strip passing the pole
+          // in between is widened until it clearly holds it.
+          const double gap = angleToArc(pole, a, b);
+          if (gap > 0.45 * tol && gap <= 1.01 * strip.reach) strip = thinStrip(a, b, 2.0 * gap);
+          std::vector<Vec2> loop;
+          for (const Vec3& n : strip.loop) loop.push_back(grid_.project(n));
+          if (gap <= 1.01 * strip.reach) {
+            // The strip's image is the outside of its projected loop (as for a cell holding
+            // the pole, above).
+            insertOutside(loop);
+          } else {
+            pieces_.push_back({counterClockwise(grid_.toPolygon(loop))});
+          }
         }
       }
     }
   }
-  // Many pieces (thousands of patches: a trimmed face's pieces): one sweep over all their
-  // overlapping loops makes Clipper's intersection lists grow with the square of the edges
-  // a scanbeam crosses (bearing.iges's 11,336 pieces: 82 % of the time in BuildIntersectList).
-  // United in groups first, a balanced tree of unions, each sweep sees a few pieces and the
-  // edges inside their union vanish before the next level. The region is the same (union is
-  // associative; the new vertices at crossings are rounded to the grid at each level, within
-  // a grid step, as the one sweep's are); a map of a few hundred pieces keeps the one sweep.
-  while (omega.size() > kOneSweepPieces) {
-    std::vector<IntLoops> united;
-    for (std::size_t start = 0; start < omega.size(); start += kUnionGroup) {
-      IntLoops group;
-      for (std::size_t i = start; i < std::min(start + kUnionGroup, omega.size()); ++i)
-        group.insert(group.end(), omega[i].begin(), omega[i].end());
-      united.push_back(run(ClipperLib::ctUnion, group, {}, ClipperLib::pftPositive, ClipperLib::pftPositive));
+
+  // The complement of the pieces' union within the pole cell's loop (the pieces are used up).
+  IntLoops complement() {
+    // Many pieces (thousands of patches: a trimmed face's pieces): one sweep over all their
+    // overlapping loops makes Clipper's intersection lists grow with the square of the edges
+    // a scanbeam crosses (bearing.iges's 11,336 pieces: 82 % of the time in BuildIntersectList).
+    // United in groups first, a balanced tree of unions, each sweep sees a few pieces and the
+    // edges inside their union vanish before the next level. The region is the same (union is
+    // associative; the new vertices at crossings are rounded to the grid at each level, within
+    // a grid step, as the one sweep's are); a map of a few hundred pieces keeps the one sweep.
+    std::vector<IntLoops> omega = std::move(pieces_);
+    while (omega.size() > kOneSweepPieces) {
+      std::vector<IntLoops> united;
+      for (std::size_t start = 0; start < omega.size(); start += kUnionGroup) {
+        IntLoops group;
+        for (std::size_t i = start; i < std::min(start + kUnionGroup, omega.size()); ++i)
+          group.insert(group.end(), omega[i].begin(), omega[i].end());
+        united.push_back(clip(ClipperLib::ctUnion, group, {}, ClipperLib::pftPositive, ClipperLib::pftPositive));
+      }
+      omega = std::move(united);
     }
-    omega = std::move(united);
+    IntLoops omegaLoops;
+    for (const IntLoops& piece : omega) omegaLoops.insert(omegaLoops.end(), piece.begin(), piece.end());
+    return clip(ClipperLib::ctDifference, {outerLoop_}, omegaLoops, ClipperLib::pftPositive,
+                ClipperLib::pftPositive);
   }
-  IntLoops omegaLoops;
-  for (const IntLoops& piece : omega) omegaLoops.insert(omegaLoops.end(), piece.begin(), piece.end());
-  const IntLoops complement = run(ClipperLib::ctDifference, {outerLoop}, omegaLoops,
-                                  ClipperLib::pftPositive, ClipperLib::pftPositive);
-  // Parts of the complement may touch at a vertex (two sheets meeting at a point); the
-  // medial axis needs disjoint loops. Shrinking by two grid steps (2^-28 of the pole cell
-  // loop's extent; mitred corners) separates them and removes slivers thinner than four
-  // steps; it only grows Omega (see Accuracy in the contract for what it costs).
+
+ private:
+  // An image that holds the pole is the outside of its projected loop (within the window).
+  void insertOutside(const std::vector<Vec2>& loop) {
+    pieces_.push_back(clip(ClipperLib::ctDifference, {outerLoop_}, {counterClockwise(grid_.toPolygon(loop))},
+                           ClipperLib::pftPositive, ClipperLib::pftPositive));
+  }
+
+  const PlaneGrid& grid_;
+  IntLoop outerLoop_;
+  std::vector<IntLoops> pieces_;
+};
+
+// The complement's loops in the plane, apart and without slivers. Parts of the complement
+// may touch at a vertex (two sheets meeting at a point); the medial axis needs disjoint
+// loops. Shrinking by two grid steps (2^-28 of the pole cell loop's extent; mitred corners)
+// separates them and removes slivers thinner than four steps; it only grows Omega (see
+// Accuracy in the contract for what it costs).
+std::vector<std::vector<Vec2>> separatedLoops(const IntLoops& complement, const PlaneGrid& grid) {
   ClipperLib::PolyTree shrunk;
   try {
     ClipperLib::ClipperOffset offset;
@@ -1690,17 +1698,116 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
   }
   double largest = 0.0;
   for (const Part& part : parts) largest = std::max(largest, part.area);
-  auto toLoop = [&](const IntLoop& contour) {
-    std::vector<Vec2> loop;
-    loop.reserve(contour.size());
-    for (const IntPoint& p : contour) loop.push_back({static_cast<double>(p.X) / scale, static_cast<double>(p.Y) / scale});
-    return loop;
-  };
+  std::vector<std::vector<Vec2>> loops;
   for (const Part& part : parts) {
     if (part.area < 1e-6 * largest) continue;
-    map.loops.push_back(toLoop(part.outline->Contour));
-    for (const ClipperLib::PolyNode* hole : part.outline->Childs) map.loops.push_back(toLoop(hole->Contour));
+    loops.push_back(grid.toLoop(part.outline->Contour));
+    for (const ClipperLib::PolyNode* hole : part.outline->Childs) loops.push_back(grid.toLoop(hole->Contour));
   }
+  return loops;
+}
+
+}  // namespace
+
+bool isSymmetrizedNormal(const Surface& surface, const Vec3& direction) {
+  std::vector<PatchData> patches;
+  for (const BezierPatch& p : cornerResolved(surface).patches) patches.push_back(makePatchData(p));
+  return inOmega(patches, normalized(direction));
+}
+
+GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& options) {
+  validateOptions(options);
+  if (surface.patches.empty()) throw Error("the surface has no patches");
+  const double tol = options.toleranceRad;
+  GaussMap map;
+  std::vector<PatchData> patches;
+  // Corners where q vanishes are blown up into fans (surface.hpp's cornerPieces): their ray
+  // limits become an apex row's curve, a boundary like any other.
+  std::vector<std::size_t> sources;
+  const Surface resolved = cornerResolved(surface, &sources);
+  for (std::size_t i = 0; i < resolved.patches.size(); ++i) {
+    patches.push_back(makePatchData(resolved.patches[i]));
+    patches.back().index = sources[i];
+  }
+  markSeams(patches);
+
+  // At fine tolerances, a coarse map first: curves farther than a band around its boundary
+  // lie deep inside Omega, and their polygons need only its tolerance (see BoundaryBand and
+  // the contract). Pieces on seams are exempt: two patches' polygons of one curve, each
+  // within its own tolerance, leave a sliver between them that would be a gap in Omega.
+  std::optional<BoundaryBand> band;
+  if (options.coarseBand && kCoarseBandFactor * tol <= kCoarseToleranceRad) {
+    GaussMapOptions coarseOptions = options;
+    coarseOptions.toleranceRad = kCoarseToleranceRad;
+    const GaussMap coarse = symmetrizedGaussMap(surface, coarseOptions);
+    if (coarse.kind == GaussMapKind::region) {
+      band.emplace(coarse.sphereCurves, kBandWidthTolerances * kCoarseToleranceRad);
+    }
+  }
+
+  PatchCells patchCells = buildPatchCells(patches, tol, options.maxCellDepth);
+  std::vector<CellBuilder>& builders = patchCells.builders;
+  const bool allDevelopable = builders.empty();
+
+  const Vec3 first = unitNormal(surface.patches.front(), 0.5, 0.5);
+  const PoleCell poleCell = choosePoleCell(builders, tol);
+  map.pole = poleNormal(builders, poleCell, options.offsetPole, first);
+  map.toPoleFrame = rotationTaking(map.pole, {0.0, 0.0, 1.0});
+
+  const NormalSampler sampler{tol, map.toPoleFrame};
+  NormalSampler inner = sampler;  // for curves off the seams (see BoundaryBand)
+  if (band) inner.band = &*band, inner.coarseTol = kCoarseToleranceRad;
+  const CurvedImages curved = imagesOfCurvedPatches(builders, poleCell, map.pole, sampler, inner);
+  // Among curved patches a developable patch's curve is thickened into a strip of half-width
+  // tol / 2 around a polygon sampled to tol / 2 (see OmegaPieces::addCurves): sampled to tol
+  // alone, it is the image itself.
+  const NormalSampler curveSampler{allDevelopable ? tol : 0.5 * tol, map.toPoleFrame};
+  const std::vector<std::vector<Vec3>> curves = developableCurves(patchCells.developablePatches, curveSampler);
+
+  // All normals within the tolerance of one direction: a plane.
+  const double spread = spreadAbout(first, curved.cells, curves);
+  auto asPoint = [&] {
+    map.kind = GaussMapKind::point;
+    map.pole = first;
+    map.toPoleFrame = rotationTaking(first, {0.0, 0.0, 1.0});
+    map.sphereCurves = {{first}, {-first}};
+    return map;
+  };
+  if (spread <= tol) return asPoint();
+  if (allDevelopable) {
+    map.kind = GaussMapKind::curve;
+    for (const auto& curve : curves) {
+      map.sphereCurves.push_back(curve);
+      std::vector<Vec3> opposite;
+      for (const Vec3& n : curve) opposite.push_back(-n);
+      map.sphereCurves.push_back(std::move(opposite));
+    }
+    return map;
+  }
+  if (poleCell.builder == builders.size()) throw Error("the Gauss map has no regular cell (K = 0 almost everywhere)");
+
+  // The pole cell's boundary bounds everything else: scale it into the integer grid.
+  PlaneGrid grid{map.toPoleFrame};
+  std::vector<Vec2> outer;
+  for (const Vec3& n : curved.cells[curved.poleCell].normals) outer.push_back(grid.project(n));
+  double extent = 0.0;
+  for (const Vec2& p : outer) extent = std::max({extent, std::abs(p.x), std::abs(p.y)});
+  grid.scale = static_cast<double>(1 << 29) / extent;
+  grid.window = (2.0 - 0x1p-28) * extent;
+  // A map too small for the grid: the antipodal image lies about the origin, where a grid
+  // step of extent / 2^29 spans two steps' angle, while the pole cell's image reaches out
+  // to ~2 / (its angular radius). With the normals' spread under 32 steps (2^-24 extent) the
+  // antipodal image would collapse to a few grid points (a nearly flat surface: 1 mm of twist
+  // over 10 km): the map is reported as a point, like a plane's, and optimalSlicing measures
+  // alpha on the surface itself.
+  if (spread <= 0x1p-24 * extent) return asPoint();
+
+  OmegaPieces omega(grid, counterClockwise(grid.toPolygon(outer)));
+  omega.addCells(curved.cells, curved.poleCell);
+  omega.addCurves(curves, map.pole, tol);
+  map.loops = separatedLoops(omega.complement(), grid);
+
+  const Rotation3 back = transpose(map.toPoleFrame);
   for (const auto& loop : map.loops) {
     map.boundarySegments += loop.size();
     std::vector<Vec3> onSphere;
@@ -1708,15 +1815,15 @@ GaussMap symmetrizedGaussMap(const Surface& surface, const GaussMapOptions& opti
     onSphere.push_back(onSphere.front());
     map.sphereCurves.push_back(std::move(onSphere));
   }
-  map.candidatePieces = cells.size();
-  for (const CellImage& c : cells) {
+  map.candidatePieces = curved.cells.size();
+  for (const CellImage& c : curved.cells) {
     map.imageVertices += c.normals.size();
     for (const SheetPart& part : c.parts) map.imageVertices += part.normals.size();
   }
-  map.parabolicCurves = imageStats.parabolicLines;
-  map.foldCells = foldCells;
-  map.tracedCells = imageStats.tracedCells;
-  map.untracedCells = imageStats.untracedCells;
+  map.parabolicCurves = curved.stats.parabolicLines;
+  map.foldCells = curved.foldCells;
+  map.tracedCells = curved.stats.tracedCells;
+  map.untracedCells = curved.stats.untracedCells;
   map.coarseBandUsed = band.has_value();
   return map;
 }
