@@ -189,14 +189,14 @@ void printSummary(const std::string& source, const OptimalSlicing& result, bool 
   for (const OutputFile& output : outputs) {
     written += (written.empty() ? "" : ", ") + output.path;
   }
-  if (result.method == "covered") {
+  if (result.method == SlicingMethod::covered) {
     fmt::print(stderr,
                "scallop: {}: no slicing direction exists: the surface's normals cover the whole "
                "sphere (proven, {} caps), alpha* = 0; {:.3f} s -> {}\n",
                source, result.coverage.caps, result.seconds, written);
     return;
   }
-  if (result.method == "lattice") {
+  if (result.method == SlicingMethod::lattice) {
     fmt::print(stderr,
                "scallop: {}: the Gauss map leaves no direction free within its tolerance, but no "
                "proof covers every direction (none found near ({:.4f}, {:.4f}, {:.4f})); best "
@@ -222,7 +222,7 @@ void printTrimmedSummary(const std::string& source, const OptimalSlicing& result
   std::string written;
   for (const OutputFile& output : outputs) written += (written.empty() ? "" : ", ") + output.path;
   const std::string lower =
-      result.method == "open"
+      result.method == SlicingMethod::open
           ? std::string("alpha* >= 0 (the pieces, boundary pieces included, leave no direction free)")
       : certify && result.certified
           ? fmt::format("alpha* >= {:.4f} deg (certified over the faces and their boundary pieces)",
@@ -230,9 +230,9 @@ void printTrimmedSummary(const std::string& source, const OptimalSlicing& result
           : fmt::format("alpha* >= {:.4f} deg ({})", toDegrees(result.alphaRad), certificateSummary(result, certify));
   std::string upper = "no upper bound (no piece lies wholly inside a face)";
   if (facts.inside != nullptr) {
-    if (facts.inside->method == "covered") {
+    if (facts.inside->method == SlicingMethod::covered) {
       upper = "alpha* = 0: the normals inside the faces alone cover the sphere (proven): no slicing direction exists";
-    } else if (facts.inside->method == "open" || facts.inside->method == "lattice") {
+    } else if (facts.inside->method == SlicingMethod::open || facts.inside->method == SlicingMethod::lattice) {
       upper = "no upper bound: the pieces inside the faces leave no direction free within the Gauss map's tolerance, "
               "unproven";
     } else {

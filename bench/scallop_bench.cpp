@@ -151,7 +151,7 @@ void BM_OrientTeapotPatch(benchmark::State& state) {
 void BM_OrientTeapot(benchmark::State& state, const char* name) {
   const scallop::OptimalSlicing result = timeOrient(state, scallop::exampleSurface(name));
   state.counters["alpha_deg"] = result.alphaRad / kDegree;
-  state.counters["covered"] = result.method == "covered" ? 1.0 : 0.0;
+  state.counters["covered"] = result.method == scallop::SlicingMethod::covered ? 1.0 : 0.0;
 }
 
 // Paper-1's patch with corners made singular (p01 = p00 at (0, 0); with range 2 also

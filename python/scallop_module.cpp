@@ -858,8 +858,9 @@ PYBIND11_MODULE(scallop, m) {
           "The polish's alpha when the certificate refuted it (alpha_deg is then what it proves), else 0.")
       .def_readonly("certificate_cells", &scallop::OptimalSlicing::certificateCells,
                     "Quadtree cells the certificate examined.")
-      .def_readonly("method", &scallop::OptimalSlicing::method,
-                    "'medial-axis'; 'plane' or 'curve' (degenerate Gauss maps); 'covered', 'lattice', 'open' (no "
+      .def_property_readonly(
+          "method", [](const scallop::OptimalSlicing& o) { return scallop::slicingMethodName(o.method); },
+          "'medial-axis'; 'plane' or 'curve' (degenerate Gauss maps); 'covered', 'lattice', 'open' (no "
                     "complement).")
       .def_property_readonly(
           "pole", [](const scallop::OptimalSlicing& o) { return vec3Array(o.pole); },

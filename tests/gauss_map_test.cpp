@@ -35,6 +35,7 @@ using scallop::Vec3;
 constexpr double kDeg = std::numbers::pi / 180.0;
 
 using scallop::reference::sampleNormals;
+using scallop::SlicingMethod;
 // The angle between a direction and the nearest of +-(the sampled normals).
 const auto angleToSamples = scallop::reference::sampledAlpha;
 
@@ -427,7 +428,7 @@ TEST(GaussMap, TeapotMapsKeepEveryNormal) {
   auto check = [&](const Surface& s, const std::string& name) {
     SCOPED_TRACE(name);
     const scallop::OptimalSlicing result = scallop::optimalSlicing(s);
-    ASSERT_EQ(result.method, "medial-axis");
+    ASSERT_EQ(result.method, SlicingMethod::medialAxis);
     const Check c = checkAgainstSamples(s, result.gaussMap, tol, 60);
     normals += c.normals;
     worst = std::max(worst, c.worstDepthRad);

@@ -34,6 +34,8 @@ constexpr double kDeg = std::numbers::pi / 180.0;
 
 using scallop::reference::sampledAlpha;
 using scallop::reference::sampleNormals;
+using scallop::SlicingMethod;
+using scallop::slicingMethodName;
 
 // The true alpha of a direction, independently of the library's own search: a fine grid
 // per patch, then a local refinement of the grid's worst points by golden-section-like
@@ -404,7 +406,7 @@ TEST(OptimalSlicing, PlaneAndCylinder) {
   }
   plane.patches.push_back(p);
   const scallop::OptimalSlicing flat = scallop::optimalSlicing(plane);
-  EXPECT_EQ(flat.method, "plane");
+  EXPECT_EQ(flat.method, SlicingMethod::plane);
   EXPECT_NEAR(flat.alphaRad, std::numbers::pi / 2, 1e-9);
   EXPECT_NEAR(trueAlpha(plane, flat.normal), std::numbers::pi / 2, 1e-9);
   // A cylinder-like patch z = f(x) only: normals lie on a great circle; the axis (y) is at
@@ -435,7 +437,7 @@ TEST(OptimalSlicing, NearlyFlatSurfaceAtFineTolerances) {
     options.toleranceRad = toleranceDeg * kDeg;
     const scallop::OptimalSlicing result = scallop::optimalSlicing(s, options);
     EXPECT_EQ(result.gaussMap.kind, scallop::GaussMapKind::point);
-    EXPECT_EQ(result.method, "plane");
+    EXPECT_EQ(result.method, SlicingMethod::plane);
     EXPECT_TRUE(result.certified);
     EXPECT_LT(result.alphaRad, std::numbers::pi / 2);
     EXPECT_GT(result.alphaRad, std::numbers::pi / 2 - 2e-7);
@@ -872,13 +874,13 @@ TEST(OptimalSlicing, MixedMultiPatchSurfacesAlwaysGiveCertifiedAnswers) {
               sampledAlpha(scallop::reference::sampleRegularNormals(s, 40), result.normal) + 1e-12);
     // A free direction exists on all of these (open patches side by side): the map must
     // find it, not call the complement empty.
-    EXPECT_NE(result.method, "lattice");
-    EXPECT_NE(result.method, "covered");
+    EXPECT_NE(result.method, SlicingMethod::lattice);
+    EXPECT_NE(result.method, SlicingMethod::covered);
     if (trial % 16 == 0) {
       // Every 16th against the brute force's best direction on the continuous surface.
       const scallop::reference::BruteForceSlicing bruteForce = scallop::reference::bruteForceOptimalAlpha(s);
       EXPECT_LE(scallop::reference::nearestNormalAngle(s, bruteForce.direction), result.alphaRad + 0.01 * kDeg)
-          << result.method;
+          << slicingMethodName(result.method);
     }
     ++answered;
   }
@@ -928,7 +930,7 @@ TEST(OptimalSlicing, NearlyFlatPatchBesideOthersMatchesBruteForce) {
     // scallop's answer is what the surface allows at N*, both within 0.01 degree.
     const scallop::reference::BruteForceSlicing bruteForce = scallop::reference::bruteForceOptimalAlpha(*s);
     EXPECT_LE(scallop::reference::nearestNormalAngle(*s, bruteForce.direction), result.alphaRad + 0.01 * kDeg)
-        << result.method;
+        << slicingMethodName(result.method);
     EXPECT_GE(result.alphaRad, scallop::reference::nearestNormalAngle(*s, result.normal) - 0.01 * kDeg);
     EXPECT_LE(result.certifiedAlphaRad,
               sampledAlpha(scallop::reference::sampleRegularNormals(*s, 200), result.normal) + 1e-12);
@@ -967,7 +969,7 @@ TEST(OptimalSlicing, SingularCornersMatchBruteForce) {
     ASSERT_FALSE(options.latticeSeeds);
     scallop::OptimalSlicing result;
     ASSERT_NO_THROW(result = scallop::optimalSlicing(s, options));
-    EXPECT_EQ(result.method, "medial-axis");
+    EXPECT_EQ(result.method, SlicingMethod::medialAxis);
     EXPECT_TRUE(result.certified);
     const std::vector<Vec3> dense = scallop::reference::sampleRegularNormals(s, 100);
     EXPECT_GE(sampledAlpha(dense, result.normal), result.certifiedAlphaRad - 1e-12);

@@ -51,7 +51,7 @@ const OptimalSlicing& exampleResult(const std::string& name) {
 // A plane: Omega is {p, -p}, every direction orthogonal to p is optimal (alpha* = 90).
 OptimalSlicing planeResult() {
   OptimalSlicing result;
-  result.method = "plane";
+  result.method = SlicingMethod::plane;
   result.gaussMap.kind = GaussMapKind::point;
   result.pole = result.gaussMap.pole = {0.0, 0.0, 1.0};
   result.normal = {1.0, 0.0, 0.0};
@@ -64,7 +64,7 @@ OptimalSlicing planeResult() {
 // stereographic image runs off to infinity.
 OptimalSlicing curveResult() {
   OptimalSlicing result;
-  result.method = "curve";
+  result.method = SlicingMethod::curve;
   result.gaussMap.kind = GaussMapKind::curve;
   result.pole = result.gaussMap.pole = {0.0, 0.0, 1.0};
   std::vector<Vec3> arc;
@@ -127,8 +127,8 @@ TEST(OrientJson, EveryKeyInOrderAndEveryNumberBitForBit) {
     expectSameDouble(doc.at("certified_alpha_deg"), toDegrees(result.certifiedAlphaRad),
                      "certified_alpha_deg");
     EXPECT_EQ(doc.at("certificate_cells").get<std::size_t>(), result.certificateCells);
-    EXPECT_EQ(doc.at("method").get<std::string>(), result.method);
-    ASSERT_EQ(result.method, "medial-axis");
+    EXPECT_EQ(doc.at("method").get<std::string>(), slicingMethodName(result.method));
+    ASSERT_EQ(result.method, SlicingMethod::medialAxis);
     const Json& circle = doc.at("circle");
     ASSERT_TRUE(circle.at("center").is_array() && circle.at("center").size() == 2);
     expectSameDouble(circle.at("center")[0], result.circle.center.x, "circle.center[0]");
@@ -177,11 +177,11 @@ TEST(OrientJson, NormalIsUnitAndAlphaInRange) {
 
 TEST(OrientJson, DegenerateGaussImagesHaveNoPlaneCircle) {
   for (const OptimalSlicing& result : {planeResult(), curveResult()}) {
-    SCOPED_TRACE(result.method);
+    SCOPED_TRACE(slicingMethodName(result.method));
     const Json doc = Json::parse(orientationToJson(result, 0.25));
     EXPECT_TRUE(doc.at("circle").is_null());
-    EXPECT_EQ(doc.at("method"), result.method);
-    EXPECT_EQ(doc.at("gauss_map").at("kind"), result.method == "plane" ? "point" : "curve");
+    EXPECT_EQ(doc.at("method"), slicingMethodName(result.method));
+    EXPECT_EQ(doc.at("gauss_map").at("kind"), result.method == SlicingMethod::plane ? "point" : "curve");
     EXPECT_EQ(doc.at("alpha_deg").get<double>(), 90.0);
   }
 }
@@ -246,7 +246,7 @@ TEST(OrientSvg, FiguresAreWellFormedFixedPointAndDeterministic) {
     EXPECT_NE(sphere.find("<path class=\"circle\""), std::string::npos);
     EXPECT_NE(sphere.find("<circle class=\"centre\""), std::string::npos);
     EXPECT_NE(plane.find("<circle class=\"unit\""), std::string::npos);
-    if (result.method == "medial-axis") {
+    if (result.method == SlicingMethod::medialAxis) {
       EXPECT_NE(plane.find("<circle class=\"circle\""), std::string::npos);
       EXPECT_NE(plane.find("<path class=\"medial\""), std::string::npos);
       EXPECT_NE(plane.find("<path class=\"omega\""), std::string::npos);
@@ -278,7 +278,7 @@ TEST(OrientSvg, TitlesGiveNStarAndAlphaStar) {
 // boundary; the JSON carries the proof.
 TEST(OrientSvg, CoveredSphereSaysSoAndIsShadedWhole) {
   const OptimalSlicing result = scallop::optimalSlicing(scallop::exampleSurface("teapot"));
-  ASSERT_EQ(result.method, "covered");
+  ASSERT_EQ(result.method, SlicingMethod::covered);
   const std::string sphere = gaussMapSphereSvg(result);
   EXPECT_NE(sphere.find("it covers the whole sphere, so no slicing direction exists"), std::string::npos);
   std::size_t shaded = 0;

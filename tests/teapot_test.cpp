@@ -68,7 +68,7 @@ TEST(Teapot, OrientMatchesBruteForceOnEveryPatchAndOpenGroup) {
     const OptimalSlicing result = optimalSlicing(s, options);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const reference::BruteForceSlicing bruteForce = reference::bruteForceOptimalAlpha(s);
-    EXPECT_EQ(result.method, "medial-axis");
+    EXPECT_EQ(result.method, SlicingMethod::medialAxis);
     EXPECT_TRUE(result.certified);
     EXPECT_NEAR(result.alphaRad, bruteForce.alphaRad, 0.01 * kDeg)
         << "brute force at (" << bruteForce.direction.x << ", " << bruteForce.direction.y << ", "
@@ -107,8 +107,8 @@ TEST(Teapot, ClosedGroupsClaimNothingUnproven) {
     SCOPED_TRACE(c.name);
     const Surface s = patchesOf(whole, c.first, c.last);
     const OptimalSlicing result = optimalSlicing(s);
-    ASSERT_TRUE(result.method == "covered" || result.method == "lattice") << result.method;
-    EXPECT_EQ(result.coverage.proven, result.method == "covered");
+    ASSERT_TRUE(result.method == SlicingMethod::covered || result.method == SlicingMethod::lattice) << slicingMethodName(result.method);
+    EXPECT_EQ(result.coverage.proven, result.method == SlicingMethod::covered);
     EXPECT_TRUE(result.certified);
     // The certified angle at N* can be no larger than the samples' angle there.
     const std::vector<Vec3> dense = reference::sampleRegularNormals(s, 160);
@@ -124,7 +124,7 @@ TEST(Teapot, ClosedGroupsClaimNothingUnproven) {
   // Which are proven today: all but the spout, whose (0, 1, 0) is a normal only on free
   // edges and at seam folds of local degree 0 (normal_coverage.hpp, Limits).
   for (const Case& c : {Case{"rim", 0, 3}, Case{"lid", 20, 27}, Case{"bottom", 28, 31}, Case{"whole", 0, 31}}) {
-    EXPECT_EQ(optimalSlicing(patchesOf(whole, c.first, c.last)).method, "covered") << c.name;
+    EXPECT_EQ(optimalSlicing(patchesOf(whole, c.first, c.last)).method, SlicingMethod::covered) << c.name;
   }
 }
 
@@ -212,7 +212,7 @@ TEST(Teapot, RandomSurfacesOfRevolutionMatchBruteForce) {
         << "brute force at (" << bruteForce.direction.x << ", " << bruteForce.direction.y << ", "
         << bruteForce.direction.z << ")";
     std::printf("[          ] trial %d: %s alpha %.5f deg (%.5f at N*), brute force %.5f (%.5f "
-                "refined)\n", trial, result.method.c_str(), result.alphaRad / kDeg,
+                "refined)\n", trial, slicingMethodName(result.method), result.alphaRad / kDeg,
                 atOptimum / kDeg, bruteForce.alphaRad / kDeg, atBruteForce / kDeg);
     ++tested;
   }

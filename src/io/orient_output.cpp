@@ -59,8 +59,8 @@ Json documentJson(const OptimalSlicing& result, double toleranceDeg) {
   // The polish's angle that the certificate refuted, when it did (alpha_deg is then proven).
   document["refuted_alpha_deg"] =
       result.uncertifiedAlphaRad > 0.0 ? Json(toDegrees(result.uncertifiedAlphaRad)) : Json(nullptr);
-  document["method"] = result.method;
-  if (result.method == "medial-axis") {
+  document["method"] = slicingMethodName(result.method);
+  if (result.method == SlicingMethod::medialAxis) {
     Json circle;
     circle["center"] = vec2Json(result.circle.center);
     circle["radius"] = result.circle.radius;
@@ -93,7 +93,7 @@ Json documentJson(const OptimalSlicing& result, double toleranceDeg) {
   medialAxis["segments"] = result.medialAxisSegments;
   medialAxis["refinements"] = result.medialAxisRefinements;
   document["medial_axis"] = medialAxis;
-  if (result.method == "covered" || result.method == "lattice") {
+  if (result.method == SlicingMethod::covered || result.method == SlicingMethod::lattice) {
     // The covering proof, tried because the complement came out empty.
     const NormalCoverage& coverage = result.coverage;
     Json proof;
@@ -781,7 +781,7 @@ PlaneView wholeView(const OptimalSlicing& result, const PlaneGeometry& geometry)
       if (norm(p) < 4.0) box.add(p);
     }
   }
-  if (result.method == "medial-axis") box.addCircle(result.circle.center, result.circle.radius);
+  if (result.method == SlicingMethod::medialAxis) box.addCircle(result.circle.center, result.circle.radius);
   PlaneView view;
   view.centre = {0.5 * (box.minX + box.maxX), 0.5 * (box.minY + box.maxY)};
   view.halfWidth = 0.5 * std::max(box.maxX - box.minX, box.maxY - box.minY) * (1.0 + 2.0 * kPlanePadding);
@@ -882,7 +882,7 @@ std::string planePanel(const OptimalSlicing& result, const PlaneGeometry& geomet
 
   out += fmt::format("<circle class=\"unit\" cx=\"{}\" cy=\"{}\" r=\"{}\"/>\n", px(view.x(0.0)),
                      px(view.y(0.0)), px(view.scale()));
-  if (result.method == "medial-axis") {
+  if (result.method == SlicingMethod::medialAxis) {
     const Vec2 c = view.page(result.circle.center);
     out += fmt::format("<circle class=\"circle\" cx=\"{}\" cy=\"{}\" r=\"{}\"/>\n", px(c.x),
                        px(c.y), px(result.circle.radius * view.scale()));
@@ -958,9 +958,9 @@ std::string trimmedOrientationToJson(const OptimalSlicing& result, double tolera
   trimmed["alpha_lower_deg"] = toDegrees(result.certified ? result.certifiedAlphaRad : result.alphaRad);
   if (facts.inside != nullptr) {
     // Without a complement and without a covering proof the inside pieces bound nothing.
-    const bool bounds = facts.inside->method != "open" && facts.inside->method != "lattice";
+    const bool bounds = facts.inside->method != SlicingMethod::open && facts.inside->method != SlicingMethod::lattice;
     trimmed["alpha_upper_deg"] = bounds ? Json(toDegrees(facts.inside->alphaRad)) : Json(nullptr);
-    trimmed["upper_method"] = facts.inside->method;
+    trimmed["upper_method"] = slicingMethodName(facts.inside->method);
     trimmed["upper_normal"] = {facts.inside->normal.x, facts.inside->normal.y, facts.inside->normal.z};
   } else {
     trimmed["alpha_upper_deg"] = nullptr;
@@ -1006,14 +1006,14 @@ std::string gaussMapSphereSvg(const OptimalSlicing& result) {
                   "angular radius \u03b1* around N* touches \u03a9 without entering it."),
       fmt::format("{}. Pole p = {}: a surface normal.", certificateLabel(result),
                   vectorLabel(result.pole, 3))};
-  if (result.method == "covered") {
+  if (result.method == SlicingMethod::covered) {
     title = "Symmetrized Gauss map \u03a9: it covers the whole sphere, so no slicing direction "
             "exists (\u03b1* = 0)";
     subtitle = {fmt::format("Proven: every direction or its opposite is a surface normal ({} "
                             "caps of directions, each inside the image of patch rectangles).",
                             result.coverage.caps),
                 fmt::format("Pole p = {}: a surface normal.", vectorLabel(result.pole, 3))};
-  } else if (result.method == "lattice") {
+  } else if (result.method == SlicingMethod::lattice) {
     title = fmt::format("Symmetrized Gauss map \u03a9: no direction free within the tolerance; "
                         "best found N = {}, \u03b1 = {}",
                         vectorLabel(result.normal), degreesLabel(result.alphaRad));
@@ -1042,7 +1042,7 @@ std::string stereographicSvg(const OptimalSlicing& result) {
   const PlaneGeometry geometry = planeGeometry(result.gaussMap);
   const PlaneView whole = wholeView(result, geometry);
   const PlaneView zoom = zoomView(geometry, whole);
-  const bool medial = result.method == "medial-axis";
+  const bool medial = result.method == SlicingMethod::medialAxis;
   const bool region = result.gaussMap.kind == GaussMapKind::region;
 
   std::vector<LegendEntry> entries;
@@ -1081,8 +1081,8 @@ std::string stereographicSvg(const OptimalSlicing& result) {
         "It maximises \u03b1 = atan(2R / (\u03c1\u00b2 \u2212 R\u00b2 + 1)), not R. {} boundary "
         "loops ({} segments), {} medial-axis edges.",
         result.gaussMap.loops.size(), result.gaussMap.boundarySegments, result.medialAxisEdges);
-  } else if (result.method == "covered" || result.method == "lattice") {
-    subtitle[0] = result.method == "covered"
+  } else if (result.method == SlicingMethod::covered || result.method == SlicingMethod::lattice) {
+    subtitle[0] = result.method == SlicingMethod::covered
                       ? std::string("\u03a9 covers the whole plane (proven): no complement, no "
                                     "medial axis, no slicing direction (\u03b1* = 0).")
                       : std::string("\u03a9 leaves no complement within its tolerance: no medial "
@@ -1091,7 +1091,7 @@ std::string stereographicSvg(const OptimalSlicing& result) {
   } else {
     subtitle[0] = fmt::format("The Gauss image has no interior (method: {}): no medial axis; "
                               "\u03b1* = {} found on the sphere.",
-                              result.method, degreesLabel(result.alphaRad));
+                              slicingMethodName(result.method), degreesLabel(result.alphaRad));
     subtitle[1] = "Only the image of the Gauss curves, the unit circle and the origin are drawn.";
   }
 

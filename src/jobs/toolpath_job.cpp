@@ -120,9 +120,9 @@ void runContour(const Surface& surface, const ToolpathOptions& options, Toolpath
                                           : minimumAngleBound(surface, normal);
     // A closed surface (the teapot) has no direction free of its normals: every plane
     // orientation touches it tangentially, so no spacing bounds the scallop height.
-    const std::string& method = result.orientation->method;
-    if (!options.spacing && (method == "covered" || method == "lattice") && !(alpha > 0.0)) {
-      throw Error(method == "covered"
+    const SlicingMethod method = result.orientation->method;
+    if (!options.spacing && (method == SlicingMethod::covered || method == SlicingMethod::lattice) && !(alpha > 0.0)) {
+      throw Error(method == SlicingMethod::covered
                       ? "no slicing direction exists: the surface's normals cover the whole "
                         "sphere (proven), so every contour plane touches it tangentially and no "
                         "spacing bounds the scallop height; use --strategy raster, or give "

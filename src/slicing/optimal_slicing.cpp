@@ -84,6 +84,18 @@ Vec3 bestDirectionForCurve(const std::vector<Vec3>& normals) {
 
 }  // namespace
 
+const char* slicingMethodName(SlicingMethod method) {
+  switch (method) {
+    case SlicingMethod::medialAxis: return "medial-axis";
+    case SlicingMethod::plane: return "plane";
+    case SlicingMethod::curve: return "curve";
+    case SlicingMethod::covered: return "covered";
+    case SlicingMethod::lattice: return "lattice";
+    case SlicingMethod::open: return "open";
+  }
+  return "unknown";
+}
+
 OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   const double tol = options.toleranceRad;
@@ -141,12 +153,12 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
     // A plane, or a surface whose normals all lie within the tolerance (or too close for
     // the Gauss map's grid, see gauss_map.hpp): a direction orthogonal to the pole, polished
     // against the true normals (below). A plane keeps 90 degrees.
-    result.method = "plane";
+    result.method = SlicingMethod::plane;
     result.normal = detail::unitOrthogonal(map.pole);
     result.alphaRad = std::numbers::pi / 2.0;
     result.sphereCircle = {result.normal, result.alphaRad};
   } else if (map.kind == GaussMapKind::curve) {
-    result.method = "curve";
+    result.method = SlicingMethod::curve;
     // The curves come in antipodal pairs (n, -n), alike for |n . N|: keep one of each.
     std::vector<Vec3> normals;
     for (std::size_t i = 0; i < map.sphereCurves.size(); i += 2) {
@@ -163,7 +175,7 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
     if (options.noComplement != NoComplement::stop) result.coverage = proveNormalsCoverSphere(surface);
     if (!result.coverage.proven && options.noComplement != NoComplement::proveThenSearch) {
       // Asked not to search: alpha >= 0 holds at every direction, and nothing more is said.
-      result.method = "open";
+      result.method = SlicingMethod::open;
       result.normal = map.pole;
       result.alphaRad = 0.0;
       result.sphereCircle = {result.normal, 0.0};
@@ -173,7 +185,7 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
       return result;
     }
     if (result.coverage.proven) {
-      result.method = "covered";
+      result.method = SlicingMethod::covered;
       result.normal = map.pole;
       result.alphaRad = 0.0;
       result.sphereCircle = {result.normal, 0.0};
@@ -182,7 +194,7 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
       result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       return result;
     }
-    result.method = "lattice";
+    result.method = SlicingMethod::lattice;
     result.normal = map.pole;
     result.alphaRad = 0.0;
     result.sphereCircle = {result.normal, 0.0};
@@ -218,13 +230,13 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
   // polygonal map stays as the medial-axis result.
   // (A curve-like image was searched on its own exact samples; its |n . N| landscape is flat
   // along the family of normals, where the pattern search only wanders.)
-  if (result.method == "medial-axis" || result.method == "lattice") {
+  if (result.method == SlicingMethod::medialAxis || result.method == SlicingMethod::lattice) {
     // Every rival is polished: the polygonal map can rank close rival optima wrongly by a
     // few tolerances, and each polish is cheap (a few Newton steps). With the option, then
     // the lattice's seeds (see latticeSeeds); the medial axis's rivals come first and win
     // ties.
     const detail::DirectionPolish polisher(working);
-    if (options.latticeSeeds || result.method == "lattice") {
+    if (options.latticeSeeds || result.method == SlicingMethod::lattice) {
       for (const Vec3& seed : polisher.latticeSeeds(2000, 4, 2.0 * std::numbers::pi / 180.0)) rivals.push_back(seed);
     }
     double bestValue = 2.0;
@@ -235,7 +247,7 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
     }
     result.alphaRad = std::acos(std::min(1.0, bestValue));
     result.sphereCircle = {result.normal, result.alphaRad};
-  } else if (result.method == "plane") {
+  } else if (result.method == SlicingMethod::plane) {
     double value = 0.0;
     const Vec3 polished = detail::DirectionPolish(working).polish(result.normal, tol, value);
     if (value > 0.0) {
@@ -243,7 +255,7 @@ OptimalSlicing optimalSlicing(const Surface& surface, const OptimalSlicingOption
       result.alphaRad = std::acos(std::min(1.0, value));
       result.sphereCircle = {result.normal, result.alphaRad};
     }
-  } else if (result.method == "curve") {
+  } else if (result.method == SlicingMethod::curve) {
     // The curves' own optimum, polished on the true surface where that is better (a nearly
     // flat curved patch among developable ones has normals off its boundary's curve, within
     // the tolerance, that the curve search does not see).

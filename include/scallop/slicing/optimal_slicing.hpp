@@ -120,6 +120,26 @@ struct OptimalSlicingOptions {
   NoComplement noComplement = NoComplement::proveThenSearch;
 };
 
+/// How optimalSlicing found N* (OptimalSlicing::method).
+enum class SlicingMethod {
+  medialAxis,  ///< the paper's: the medial axis's best circle, polished and certified
+  plane,       ///< a degenerate map: every normal one direction (or its antipode)
+  curve,       ///< a degenerate map: the normals form a curve (K = 0), searched directly
+  /// the Gauss map has no complement and a proof that the normals cover the sphere says
+  /// alpha* = 0 exactly (any direction; OptimalSlicing::coverage)
+  covered,
+  /// no complement within the map's tolerance but no such proof either: N* is the best
+  /// direction the lattice's seeds polish to, its alpha certified like any other (an honest
+  /// lower bound, possibly 0)
+  lattice,
+  /// the same without the search (OptimalSlicingOptions::noComplement), alpha 0 at the pole
+  open,
+};
+
+/// The method's name in JSON documents and messages: "medial-axis", "plane", "curve",
+/// "covered", "lattice" or "open".
+const char* slicingMethodName(SlicingMethod method);
+
 struct OptimalSlicing {
   Vec3 normal;             ///< N*, unit (its sign is arbitrary: +-N* slice alike)
   double alphaRad = 0.0;   ///< alpha*: the minimum angle between N* and +-n, radians
@@ -133,13 +153,8 @@ struct OptimalSlicing {
   /// at N* (by bisection), so an uncertified angle is never the answer. 0 otherwise.
   double uncertifiedAlphaRad = 0.0;
   std::size_t certificateCells = 0;  ///< quadtree cells the certificate examined
-  /// "medial-axis"; "plane" or "curve" (degenerate maps); "covered": the Gauss map has no
-  /// complement and a proof that the normals cover the sphere says alpha* = 0 exactly (any
-  /// direction; `coverage`); "lattice": no complement within the map's tolerance but no such
-  /// proof either: N* is the best direction the lattice's seeds polish to, its alpha
-  /// certified like any other (an honest lower bound, possibly 0); "open": the same without
-  /// the search (OptimalSlicingOptions::noComplement), alpha 0 at the pole.
-  std::string method = "medial-axis";
+  /// How N* was found (SlicingMethod).
+  SlicingMethod method = SlicingMethod::medialAxis;
   NormalCoverage coverage;  ///< the covering proof, tried when the complement is empty
   GaussMap gaussMap;
   /// The interior medial axis of the projected complement (pole frame), each edge sampled
