@@ -14,6 +14,8 @@
 // 0 (the initial setting) means every core: std::thread::hardware_concurrency(), or 1 when
 // that is unknown. Thread-safe (an atomic); meant to be set once, before the work starts.
 //
+// parallelForEach (below) is the one pool every parallel part runs on.
+//
 // Why the standard library and not TBB: the parallel parts are a handful of loops over
 // independent items whose cost is known up front (passes, sample blocks, grid rows); a pool
 // of std::jthreads pulling indices from an atomic counter balances them, keeps the result
@@ -23,7 +25,11 @@
 #include <algorithm>
 #include <atomic>
 #include <cstddef>
+#include <exception>
 #include <thread>
+#include <vector>
+
+#include "scallop/job_control.hpp"
 
 namespace scallop {
 
@@ -43,5 +49,39 @@ inline std::size_t threadCount() {
 
 /// `requested` (an option's `threads` field) when positive, else threadCount().
 inline std::size_t threadCount(std::size_t requested) { return requested > 0 ? requested : threadCount(); }
+
+/// Runs work(i) for every i in [0, count) on min(threads, count) threads, the calling thread
+/// among them; items are handed out in increasing order from a shared counter, so uneven
+/// items balance. The calling thread's job control (job_control.hpp) is installed on every
+/// worker: work polls cancellation, and progress is reported on the calling thread only.
+/// work(i) must write only its own slots (results independent of the schedule). An exception
+/// from work(i) stops no other item; once all have run, the one of the lowest i is rethrown,
+/// whatever the timing.
+template <typename Work>
+void parallelForEach(std::size_t count, std::size_t threads, const Work& work) {
+  std::vector<std::exception_ptr> errors(count);
+  std::atomic<std::size_t> next{0};
+  const auto run = [&] {
+    for (std::size_t i = next++; i < count; i = next++) {
+      try {
+        work(i);
+      } catch (...) {
+        errors[i] = std::current_exception();
+      }
+    }
+  };
+  {
+    std::vector<std::jthread> pool;
+    const JobControl* const control = currentJobControl();
+    for (std::size_t t = 1; t < std::min(threads, count); ++t)
+      pool.emplace_back([&run, control] {
+        const JobControlScope scope(control, false);
+        run();
+      });
+    run();
+  }
+  for (const std::exception_ptr& error : errors)
+    if (error) std::rethrow_exception(error);
+}
 
 }  // namespace scallop

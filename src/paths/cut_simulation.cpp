@@ -5,14 +5,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
-#include <exception>
 #include <functional>
 #include <memory>
 #include <limits>
 #include <numbers>
 #include <queue>
 #include <string>
-#include <thread>
 #include <utility>
 #include <vector>
 
@@ -715,26 +713,7 @@ using ClearancePreparation = std::function<std::function<ClearanceTest()>()>;
 void onEveryCore(std::size_t count, const std::function<void(std::size_t, std::size_t)>& work) {
   const std::size_t threads =
       std::clamp<std::size_t>(threadCount(), 1, std::max<std::size_t>(1, count / 256));
-  std::vector<std::exception_ptr> errors(threads);
-  const auto block = [&](std::size_t t) {
-    try {
-      work(count * t / threads, count * (t + 1) / threads);
-    } catch (...) {
-      errors[t] = std::current_exception();
-    }
-  };
-  {
-    std::vector<std::jthread> pool;
-    const JobControl* const control = currentJobControl();
-    for (std::size_t t = 1; t < threads; ++t)
-      pool.emplace_back([&block, control, t] {
-        const JobControlScope scope(control, false);
-        block(t);
-      });
-    block(0);
-  }
-  for (const std::exception_ptr& error : errors)
-    if (error) std::rethrow_exception(error);
+  parallelForEach(threads, threads, [&](std::size_t t) { work(count * t / threads, count * (t + 1) / threads); });
 }
 
 // The contract's Reach on a mesh: q's upward normal is that of the triangle that holds q over

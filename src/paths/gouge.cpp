@@ -10,11 +10,9 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <exception>
 #include <limits>
 #include <numbers>
 #include <string>
-#include <thread>
 #include <unordered_map>
 #include <vector>
 
@@ -1561,7 +1559,6 @@ GougeReport gougeCheck(const SurfaceDistance& distance, const ToolPath& path, do
     GougeLocation deepest;
   };
   std::vector<Block> blocks(blockStarts.size() - 1);
-  std::vector<std::exception_ptr> errors(blocks.size());
   const auto sampleBlock = [&](std::size_t b) {
     Block& block = blocks[b];
     for (std::size_t k = blockStarts[b]; k < blockStarts[b + 1]; ++k) {
@@ -1591,33 +1588,11 @@ GougeReport gougeCheck(const SurfaceDistance& distance, const ToolPath& path, do
       }
     }
   };
-  const std::size_t threads = std::clamp<std::size_t>(
-      threadCount(options.threads), 1, blocks.size());
-  {
-    // Blocks dealt round-robin: thread t takes t, t + threads, ... (the work per block is
-    // alike); each writes only its own blocks.
-    const auto run = [&](std::size_t first) {
-      for (std::size_t b = first; b < blocks.size(); b += threads) {
-        try {
-          advanceStage(b, blocks.size());  // reports on the calling thread only
-          sampleBlock(b);
-        } catch (...) {
-          errors[b] = std::current_exception();
-        }
-      }
-    };
-    std::vector<std::jthread> pool;
-    const JobControl* const control = currentJobControl();
-    for (std::size_t t = 1; t < threads; ++t)
-      pool.emplace_back([&run, control, t] {
-        const JobControlScope scope(control, false);
-        run(t);
-      });
-    run(0);
-  }
-  for (const std::exception_ptr& error : errors) {
-    if (error) std::rethrow_exception(error);  // the first block's error, whatever the timing
-  }
+  // Each block writes only its own slot; an error is the first block's, whatever the timing.
+  parallelForEach(blocks.size(), threadCount(options.threads), [&](std::size_t b) {
+    advanceStage(b, blocks.size());  // reports on the calling thread only
+    sampleBlock(b);
+  });
 
   GougeReport report;
   report.depthThreshold = options.depthThreshold;
