@@ -5,12 +5,14 @@
 #include <limits>
 #include <numbers>
 #include <optional>
+#include <vector>
 
 #include <fmt/format.h>
 
 #include "scallop/geometry/bezier.hpp"
 #include "scallop/error.hpp"
 #include "scallop/job_control.hpp"
+#include "scallop/parallel.hpp"
 #include "scallop/paths/gouge.hpp"
 #include "scallop/slicing/optimal_slicing.hpp"
 #include "paths/alignment.hpp"
@@ -161,10 +163,22 @@ ContourPaths contourPaths(const Surface& surface, const ContourOptions& options)
   };
   std::optional<SurfaceDistance> distance;
   if (options.dropEnvelope) distance.emplace(surface);
-  for (double kk = range.first; kk <= range.last; kk += 1.0) {
+  // Each plane on its own (on every core): its section and passes, and the increments of
+  // the lengths in the order the path is assembled, so that their sums come out the same,
+  // bit for bit, for every thread count.
+  struct PlaneWork {
+    PlaneSection section;
+    std::vector<ToolPass> passes;
+    std::vector<double> contactLengths;  // per curve
+    std::vector<double> centreSteps;     // per centre after each pass's first
+  };
+  const std::size_t planeCount = static_cast<std::size_t>(range.last - range.first + 1.0);
+  std::vector<PlaneWork> planes(planeCount);
+  parallelForEach(planeCount, threadCount(), [&](std::size_t i) {
     // The sections take about half of the stage, the lift to the envelope the rest.
-    advanceStage(static_cast<std::size_t>(kk - range.first), 2 * static_cast<std::size_t>(range.last - range.first + 1));
-    const long long k = static_cast<long long>(kk);
+    advanceStage(i, 2 * planeCount);  // reports on the calling thread only
+    checkCancelled();
+    const double kk = range.first + static_cast<double>(i);
     const double offset = offsetAt(kk);
     // The pass's band, half way to the neighbouring planes, for its run-on (envelope.hpp).
     RunOnBand band{out.normal, 0.0};
@@ -172,13 +186,10 @@ ContourPaths contourPaths(const Surface& surface, const ContourOptions& options)
     if (kk > range.first) band.lo = 0.5 * (offsetAt(kk - 1.0) + offset), gap = std::min(gap, offset - offsetAt(kk - 1.0));
     if (kk < range.last) band.hi = 0.5 * (offset + offsetAt(kk + 1.0)), gap = std::min(gap, offsetAt(kk + 1.0) - offset);
     const double step = runOnStep(gap, options.toolRadius);
-    PlaneSection section = planeSection(surface, out.normal, offset, tolerance);
-    out.stats.touchPoints += section.touchPoints.size();
-    if (section.curves.empty()) continue;
-    ++out.stats.planes;
-    out.stats.components += section.components;
-    for (const SectionCurve& curve : section.curves) {
-      out.stats.contactLength += curveLength(curve);
+    PlaneWork& work = planes[i];
+    work.section = planeSection(surface, out.normal, offset, tolerance);
+    for (const SectionCurve& curve : work.section.curves) {
+      work.contactLengths.push_back(curveLength(curve));
       ToolPass pass;
       bool atStart = true;
       Vec3 previous;
@@ -189,7 +200,7 @@ ContourPaths contourPaths(const Surface& surface, const ContourOptions& options)
           pass.start = centre;
           atStart = false;
         } else {
-          out.stats.centreLength += norm(centre - previous);
+          work.centreSteps.push_back(norm(centre - previous));
           pass.moves.push_back({MoveKind::line, centre, {}, ArcPlane::xy, true});
         }
         previous = centre;
@@ -204,9 +215,20 @@ ContourPaths contourPaths(const Surface& surface, const ContourOptions& options)
         runPassOn(*distance, pass, pass.start - pass.moves.front().end, passEnd(pass) - penultimate,
                   options.toolRadius, band, step);
       }
-      if (!pass.moves.empty()) out.path.passes.push_back(std::move(pass));
+      if (!pass.moves.empty()) work.passes.push_back(std::move(pass));
     }
-    out.sections.push_back({offset, k, std::move(section)});
+  });
+  for (std::size_t i = 0; i < planeCount; ++i) {
+    PlaneWork& work = planes[i];
+    out.stats.touchPoints += work.section.touchPoints.size();
+    if (work.section.curves.empty()) continue;
+    ++out.stats.planes;
+    out.stats.components += work.section.components;
+    for (const double curveContact : work.contactLengths) out.stats.contactLength += curveContact;
+    for (const double step : work.centreSteps) out.stats.centreLength += step;
+    for (ToolPass& pass : work.passes) out.path.passes.push_back(std::move(pass));
+    const double kk = range.first + static_cast<double>(i);
+    out.sections.push_back({offsetAt(kk), static_cast<long long>(kk), std::move(work.section)});
   }
   if (out.sections.empty())
     throw Error(fmt::format(

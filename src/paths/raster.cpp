@@ -11,6 +11,7 @@
 #include "scallop/geometry/bezier.hpp"
 #include "scallop/error.hpp"
 #include "scallop/job_control.hpp"
+#include "scallop/parallel.hpp"
 #include "scallop/paths/gouge.hpp"
 #include "scallop/paths/path_sampling.hpp"
 #include "paths/alignment.hpp"
@@ -589,10 +590,17 @@ RasterPaths rasterPaths(const Surface& surface, const RasterOptions& options) {
   // One plane's passes, in increasing s, not yet reversed, run on past their ends (with the
   // drop envelope): from the scallop hulls of its chains, or, where its section gives none
   // and `dropLine`, from the drop envelope along the line (envelope.hpp, dropLineRuns).
+  // Built independently of every other plane (planes are built in parallel); the path is
+  // assembled from them in order (appendPlane).
   struct PlaneBuild {
     RasterSection plane;
     std::vector<ToolPass> passes;
+    // Per pass, the ways off at its two ends as built: from its start backwards (-d) and
+    // from its end onwards (+d). A reversed pass's entry is its end's, its exit its start's
+    // (reversedPass keeps the end points bit for bit).
+    std::vector<std::pair<PassEndExit, PassEndExit>> ends;
     std::size_t components = 0;
+    std::size_t touchPoints = 0;
     double contactLength = 0.0;
     bool visible = false;
   };
@@ -600,7 +608,7 @@ RasterPaths rasterPaths(const Surface& surface, const RasterOptions& options) {
     checkCancelled();
     PlaneBuild b;
     PlaneSection section = planeSection(surface, frame.e, w, tolerance);
-    out.stats.touchPoints += section.touchPoints.size();
+    b.touchPoints = section.touchPoints.size();
     b.plane.offset = w;
     b.plane.k = k;
     if (options.dropEnvelope) {
@@ -637,6 +645,10 @@ RasterPaths rasterPaths(const Surface& surface, const RasterOptions& options) {
       }
     }
     b.plane.section = std::move(section);
+    for (const ToolPass& pass : b.passes) {
+      b.ends.emplace_back(exitFrom(distance, pass.start, -frame.d, radius, clearHeight, slack),
+                          exitFrom(distance, passEnd(pass), frame.d, radius, clearHeight, slack));
+    }
     return b;
   };
 
@@ -662,6 +674,7 @@ RasterPaths rasterPaths(const Surface& surface, const RasterOptions& options) {
         RunOnBand band{frame.e, radius};
         (side < 0 ? band.hi : band.lo) = w - 0.5 * side * gap;
         PlaneBuild b = buildPlane(w, edgeK + side * j, band, runOnStep(gap, radius), true);
+        out.stats.touchPoints += b.touchPoints;
         if (b.passes.empty()) break;
         (side < 0 ? below : above).push_back(std::move(b));
       }
@@ -690,11 +703,10 @@ RasterPaths rasterPaths(const Surface& surface, const RasterOptions& options) {
       if (plane.reversed) pass = reversedPass(pass);
       RasterPass info{index, c, plane.reversed, 0, 0.0, 0, 0};
       // Ways on and off: the entry is an exit run backwards.
-      const Vec3 forward = plane.reversed ? -frame.d : frame.d;
       const Vec3 cutEnd = passEnd(pass);
-      const PassEndExit entry =
-          exitFrom(distance, pass.start, -forward, radius, clearHeight, slack);
-      const PassEndExit exit = exitFrom(distance, cutEnd, forward, radius, clearHeight, slack);
+      const auto& [fromStart, fromEnd] = b.ends[c];
+      const PassEndExit& entry = plane.reversed ? fromEnd : fromStart;
+      const PassEndExit& exit = plane.reversed ? fromStart : fromEnd;
       out.unclearedEnds += (entry.proven ? 0 : 1) + (exit.proven ? 0 : 1);
       if (!(entry.point == pass.start)) {
         out.linkLength += norm(pass.start - entry.point);
@@ -737,17 +749,22 @@ RasterPaths rasterPaths(const Surface& surface, const RasterOptions& options) {
     out.sections.push_back(std::move(plane));
   };
 
-  for (auto b = below.rbegin(); b != below.rend(); ++b) appendPlane(std::move(*b));
-  for (double kk = range.first; kk <= range.last; kk += 1.0) {
-    const std::size_t at = below.size() + static_cast<std::size_t>(kk - range.first);
-    advanceStage(at, allOffsets.size());
+  // The given planes, each on its own (on every core), then the path from them in order.
+  std::vector<PlaneBuild> planes(planeCount);
+  parallelForEach(planeCount, threadCount(), [&](std::size_t i) {
+    const std::size_t at = below.size() + i;
+    advanceStage(at, allOffsets.size());  // reports on the calling thread only
     const double w = allOffsets[at];
     RunOnBand band{frame.e, radius};
     double gap = 4.0 * radius;
     if (at > 0) band.lo = 0.5 * (allOffsets[at - 1] + w), gap = std::min(gap, w - allOffsets[at - 1]);
     if (at + 1 < allOffsets.size()) band.hi = 0.5 * (w + allOffsets[at + 1]), gap = std::min(gap, allOffsets[at + 1] - w);
-    appendPlane(buildPlane(w, static_cast<long long>(kk), band, runOnStep(gap, radius), true));
-  }
+    planes[i] = buildPlane(w, static_cast<long long>(range.first + static_cast<double>(i)), band,
+                           runOnStep(gap, radius), true);
+  });
+  for (const PlaneBuild& b : planes) out.stats.touchPoints += b.touchPoints;
+  for (auto b = below.rbegin(); b != below.rend(); ++b) appendPlane(std::move(*b));
+  for (PlaneBuild& b : planes) appendPlane(std::move(b));
   for (PlaneBuild& b : above) appendPlane(std::move(b));
   if (out.sections.empty())
     throw Error(fmt::format(
