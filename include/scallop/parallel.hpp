@@ -3,10 +3,11 @@
 //
 // Contract
 // --------
-// Every parallel part of scallop (lifting passes to the drop envelope, the gouge check's
-// sample blocks, the cut simulation's clearance and reach checks, the exact heights of a CAD
-// part) takes its thread count from its options' `threads` field; 0 there means
-// threadCount() below. Each of them writes only its own slots and combines them in a fixed
+// Every parallel part of scallop (the contour and raster planes: section, passes, run-on and
+// ways off; lifting passes to the drop envelope; the gouge check's sample blocks; the cut
+// simulation's clearance and reach checks; the exact heights of a CAD part) takes its thread
+// count from its options' `threads` field where it has one (0 there means threadCount()
+// below), else threadCount(). Each of them writes only its own slots and combines them in a fixed
 // order, so results are the same, bit for bit, for every thread count (tests/cli_test.cpp
 // compares the files every command writes at 1 and 2 threads).
 //

@@ -3,11 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <atomic>
-#include <exception>
 #include <numbers>
 #include <optional>
-#include <thread>
 
 #include <fmt/format.h>
 
@@ -406,33 +403,11 @@ ToolPath liftToDropEnvelope(const SurfaceDistance& distance, const ToolPath& pat
   // same for any number of threads.
   const double top = ballTop(distance.surface(), radius);
   std::vector<PassLift> lifts(path.passes.size());
-  std::vector<std::exception_ptr> errors(path.passes.size());
-  std::atomic<std::size_t> nextPass{0};
-  const auto work = [&] {
-    for (std::size_t i = nextPass++; i < path.passes.size(); i = nextPass++) {
-      try {
-        advanceStage(i, path.passes.size());  // reports on the calling thread only
-        lifts[i] = liftPass(distance, path.passes[i], i, radius, eps, top, options);
-      } catch (...) {
-        errors[i] = std::current_exception();
-      }
-    }
-  };
-  const std::size_t threads = std::min<std::size_t>(
-      path.passes.size(), threadCount(options.threads));
-  {
-    std::vector<std::jthread> pool;
-    const JobControl* const control = currentJobControl();
-    for (std::size_t t = 1; t < threads; ++t)
-      pool.emplace_back([&work, control] {
-        const JobControlScope scope(control, false);
-        work();
-      });
-    work();
-  }
-  for (const std::exception_ptr& error : errors) {
-    if (error) std::rethrow_exception(error);  // the first pass's error, whatever the timing
-  }
+  // An error is the first pass's, whatever the timing.
+  parallelForEach(path.passes.size(), threadCount(options.threads), [&](std::size_t i) {
+    advanceStage(i, path.passes.size());  // reports on the calling thread only
+    lifts[i] = liftPass(distance, path.passes[i], i, radius, eps, top, options);
+  });
 
   ToolPath out;
   out.units = path.units;
