@@ -665,30 +665,47 @@ std::size_t sweepMoves(const std::vector<SweptMove>& moves, double toolRadius, H
                        std::vector<double>* lowered, std::vector<std::uint32_t>* lowestMove) {
   if (lowered) lowered->assign(moves.size(), 0.0);
   if (lowestMove) lowestMove->assign(stock.z.size(), kNoMove);
-  std::size_t visits = 0;
-  for (std::size_t m = 0; m < moves.size(); ++m) {
-    advanceStage(moves.size() + 2 * m, 3 * moves.size());  // the sweep: the rest of a simulation
-    requireMoveFinite(moves[m], m);
-    const MoveShape shape(moves[m], toolRadius);
-    const auto [is, js] = pointsNear(shape, toolRadius, stock);
-    if (is.empty() || js.empty()) continue;
-    const double floor = shape.lo().z - toolRadius;  // no point of the swept ball is lower
-    double most = 0.0;
-    for (std::size_t j = js.lo; j <= js.hi; ++j) {
-      for (std::size_t i = is.lo; i <= is.hi; ++i) {
-        double& z = stock.z[j * stock.columns + i];
-        if (z <= floor) continue;
-        const Vec2 p = stock.point(i, j);
-        const double low = shape.lowest(p.x, p.y);
-        ++visits;
-        if (low < z) {
-          most = std::max(most, z - low);
-          z = low;
-          if (lowestMove) (*lowestMove)[j * stock.columns + i] = static_cast<std::uint32_t>(m);
+  // The grid's rows in bands, one per thread; each band takes every move in order over its
+  // own rows. A point's height is the same sequence of minima as in one pass over the moves,
+  // and a move's deepest cut the maximum over the bands: the same result, bit for bit, for
+  // any number of threads.
+  const std::size_t bands = std::clamp<std::size_t>(threadCount(), 1, std::max<std::size_t>(1, stock.rows / 16));
+  std::vector<std::vector<double>> bandLowered(bands, std::vector<double>(lowered ? moves.size() : 0, 0.0));
+  std::vector<std::size_t> bandVisits(bands, 0);
+  parallelForEach(bands, bands, [&](std::size_t band) {
+    const std::size_t rowLo = stock.rows * band / bands, rowHi = stock.rows * (band + 1) / bands;
+    std::size_t visits = 0;
+    for (std::size_t m = 0; m < moves.size(); ++m) {
+      advanceStage(moves.size() + 2 * m, 3 * moves.size());  // the sweep: the rest of a simulation
+      requireMoveFinite(moves[m], m);
+      const MoveShape shape(moves[m], toolRadius);
+      const auto [is, js] = pointsNear(shape, toolRadius, stock);
+      if (is.empty() || js.empty() || js.hi < rowLo || js.lo >= rowHi) continue;
+      const double floor = shape.lo().z - toolRadius;  // no point of the swept ball is lower
+      double most = 0.0;
+      for (std::size_t j = std::max(js.lo, rowLo); j <= js.hi && j < rowHi; ++j) {
+        for (std::size_t i = is.lo; i <= is.hi; ++i) {
+          double& z = stock.z[j * stock.columns + i];
+          if (z <= floor) continue;
+          const Vec2 p = stock.point(i, j);
+          const double low = shape.lowest(p.x, p.y);
+          ++visits;
+          if (low < z) {
+            most = std::max(most, z - low);
+            z = low;
+            if (lowestMove) (*lowestMove)[j * stock.columns + i] = static_cast<std::uint32_t>(m);
+          }
         }
       }
+      if (lowered) bandLowered[band][m] = most;
     }
-    if (lowered) (*lowered)[m] = most;
+    bandVisits[band] = visits;
+  });
+  std::size_t visits = 0;
+  for (std::size_t band = 0; band < bands; ++band) {
+    visits += bandVisits[band];
+    if (lowered)
+      for (std::size_t m = 0; m < moves.size(); ++m) (*lowered)[m] = std::max((*lowered)[m], bandLowered[band][m]);
   }
   return visits;
 }
