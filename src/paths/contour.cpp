@@ -176,8 +176,7 @@ ContourPaths contourPaths(const Surface& surface, const ContourOptions& options)
   std::vector<PlaneWork> planes(planeCount);
   parallelForEach(planeCount, threadCount(), [&](std::size_t i) {
     // The sections take about half of the stage, the lift to the envelope the rest.
-    advanceStage(i, 2 * planeCount);  // reports on the calling thread only
-    checkCancelled();
+    advanceStage(i, 2 * planeCount);  // polls the cancel; reports on the calling thread only
     const double kk = range.first + static_cast<double>(i);
     const double offset = offsetAt(kk);
     // The pass's band, half way to the neighbouring planes, for its run-on (envelope.hpp).
