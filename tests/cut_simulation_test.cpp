@@ -674,6 +674,63 @@ TEST(CutSimulation, AVerticalWallGrazedByTheBallIsNoGougeButACutIntoItIs) {
   EXPECT_LT(cut.clearedGougePoints, wallPoints);
 }
 
+// A steep plane, z = 2 y over x in [0, 2], y in [0, 1], cut as a raster pass down its slope
+// ends: the ball runs down the slope `interference` nearer than R along the normal, on to R
+// beside the edge y = 0 at the height where it touches the edge, then plunges beside the
+// edge to z = 0, `beside` nearer than R to the edge line. Vertically the slope is gouged
+// sqrt(5) times the interference and the edge sqrt(2 R beside) (2.2e-3 for 1e-5); along the
+// normal, the closed-form distance below, no more than the interference. Within the
+// tolerance both are cleared, whatever the points checked before them (the strip that found
+// this: a drop envelope seeded by the slope's contact stood 2e-3 above the plunge beside the
+// edge and refused it); beyond it the slope is a gouge of at least the interference.
+TEST(CutSimulation, ASteepPatchsEdgeGrazedWithinTheToleranceIsClearedAndACutBeyondItIsNot) {
+  BezierPatch slope;
+  slope.degreeU = slope.degreeV = 1;
+  slope.control = {{0.0, 0.0, 0.0}, {0.0, 1.0, 2.0}, {2.0, 0.0, 0.0}, {2.0, 1.0, 2.0}};
+  const Surface steep{Units::inch, {slope}};
+  const double radius = 0.25, root5 = std::sqrt(5.0);
+  const Vec3 normal{0.0, -2.0 / root5, 1.0 / root5};  // upward unit normal
+  const auto planeDistance = [](Vec3 c) {
+    // The nearest point (c.x in [0, 2] here) at y in [0, 1] on z = 2 y.
+    const double y = std::clamp((c.y + 2.0 * c.z) / 5.0, 0.0, 1.0);
+    return std::hypot(c.y - y, c.z - 2.0 * y);
+  };
+  SimulationOptions options;
+  options.toolRadius = radius;
+  options.scallopHeight = 0.01;
+  options.resolution = 1.0 / 128.0;
+  options.margin = 0.0;
+  options.classifyReach = false;
+  const auto program = [&](double interference, double beside) {
+    std::vector<SweptMove> moves;
+    for (const double x : {0.5, 1.0, 1.5}) {
+      const Vec3 top = Vec3{x, 0.6, 1.2} + (radius - interference) * normal;
+      const Vec3 foot = Vec3{x, 0.0, 0.0} + (radius - interference) * normal;
+      const Vec3 edge{x, -(radius - beside), 0.0};
+      moves.push_back(lineMove(top, foot));
+      moves.push_back(lineMove(foot, Vec3{x, foot.y, radius / root5}));
+      moves.push_back(lineMove(Vec3{x, foot.y, radius / root5}, Vec3{edge.x, edge.y, radius / root5}));
+      moves.push_back(lineMove(Vec3{edge.x, edge.y, radius / root5}, edge));
+      moves.push_back(lineMove(edge, Vec3{edge.x, edge.y, 1.0}));
+      EXPECT_NEAR(planeDistance(top), radius - interference, 1e-12);
+      EXPECT_NEAR(planeDistance(edge), radius - beside, 1e-12);
+    }
+    return moves;
+  };
+
+  const SimulationReport grazed = simulateCut(steep, program(6e-5, 1e-5), options);
+  EXPECT_GT(grazed.clearedGougePoints, 100u);  // the slope and the edge beside each plunge
+  EXPECT_GT(grazed.maxClearedGouge, 2e-3);     // the edge, vertically
+  EXPECT_EQ(grazed.gougePoints, 0u);
+  EXPECT_LE(grazed.maxGouge, grazed.gougeTolerance);
+
+  const SimulationReport cut = simulateCut(steep, program(3e-4, 1e-5), options);
+  EXPECT_GE(cut.maxGouge, 3e-4);
+  EXPECT_LE(cut.maxGouge, root5 * 3e-4 + 1e-9);
+  EXPECT_GT(cut.gougePoints, 100u);
+  EXPECT_GT(cut.clearedGougePoints, 0u);  // the edge beside the plunges
+}
+
 TEST(DesignHeights, ThePaperSurfacesAgainstADenseMesh) {
   for (const std::string name : {"paper-1", "paper-2"}) expectDesignMatchesMesh(exampleSurface(name), 0.02, 1e-4, name);
 }

@@ -724,13 +724,17 @@ using ReachPreparation = std::function<std::function<ReachTest()>()>;
 using ClearanceTest = std::function<bool(Vec3)>;
 using ClearancePreparation = std::function<std::function<ClearanceTest()>()>;
 
-// Runs work(from, to) over [0, count) on up to every core, in blocks of at least 256, the
-// job's control installed on every thread (work polls it); an error (Cancelled among them)
-// is rethrown on the calling thread, the first block's first.
+// Runs work(from, to) over [0, count) on up to every core, in blocks of kCoreBlock (the last
+// one shorter) whatever the number of threads, so that work which carries a state from one
+// item to the next within a block (a drop cutter's seed) gives the same results on any
+// number of threads; the job's control installed on every thread (work polls it); an error
+// (Cancelled among them) is rethrown on the calling thread, the first block's first.
+constexpr std::size_t kCoreBlock = 256;
 void onEveryCore(std::size_t count, const std::function<void(std::size_t, std::size_t)>& work) {
-  const std::size_t threads =
-      std::clamp<std::size_t>(threadCount(), 1, std::max<std::size_t>(1, count / 256));
-  parallelForEach(threads, threads, [&](std::size_t t) { work(count * t / threads, count * (t + 1) / threads); });
+  const std::size_t blocks = (count + kCoreBlock - 1) / kCoreBlock;
+  parallelForEach(blocks, threadCount(), [&](std::size_t block) {
+    work(block * kCoreBlock, std::min(count, (block + 1) * kCoreBlock));
+  });
 }
 
 // The contract's Reach on a mesh: q's upward normal is that of the triangle that holds q over
@@ -807,15 +811,15 @@ SimulationReport simulateCut(const Surface& surface, const std::vector<SweptMove
       },
       start,
       [&]() -> std::function<ClearanceTest()> {
-        // eps = a quarter of the gouge tolerance (the default 1e-6 scale when that is 0).
-        EnvelopeOptions envelope;
-        envelope.depthTolerance = std::min(slack / 4.0, 0.25 * radius);
-        return [distance = sharedDistance(), radius, slack, envelope]() -> ClearanceTest {
-          auto cutter = std::make_shared<DropCutter>(*distance, radius, envelope);
-          const double eps = envelope.depthTolerance > 0.0 ? envelope.depthTolerance
-                                                           : 1e-6 * std::max(surfaceScale(distance->surface()), 1e-300);
-          const double below = std::max(0.0, slack - 0.5 * eps);
-          return [distance, cutter, below](Vec3 c) { return c.z >= cutter->height(c.x, c.y) - below; };
+        // The segment from c up to above the whole surface (R over its highest control
+        // point, and a hair), proven R - gougeTolerance clear.
+        const double highest = controlPointTop(surface);
+        const double top = highest + radius * (1.0 + 1e-9) + 1e-9 * std::abs(highest);
+        return [distance = sharedDistance(), clearance = radius - slack, top]() -> ClearanceTest {
+          return [distance, clearance, top](Vec3 c) {
+            if (c.z >= top) return true;
+            return distance->segmentClearance(c, {c.x, c.y, top}, clearance).verdict == Clearance::proven;
+          };
         };
       });
   return report;

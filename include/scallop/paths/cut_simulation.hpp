@@ -86,21 +86,28 @@
 //         a smaller tool's work) and left out of the scallop figures, which are then the
 //         plan's own doing. Not a proof that no other centre comes nearer (a centre beside c
 //         may): a heuristic classification of what is left, in the report for what it is.
-//         Only points above H are classified, on every core, within maxReachChecks.
+//         Only points above H are classified, on every core, within maxReachChecks, in
+//         blocks of a fixed size each with its own drop cutter (whose heights depend on the
+//         queries before: its Newton seed), so that the classes are the same for any number
+//         of threads.
 // Vertical walls: the vertical measure is ill-posed over a vertical wall lying along grid
 //         points: the design there is the wall's top, while a ball running beside the wall,
 //         tangent to it, lowers those points to its centre's height, a "gouge" of the wall's
 //         height where nothing of the part was cut. So on a Surface, a point whose vertical
 //         gouge exceeds the tolerance is checked against the ball that cut it lowest: the
 //         line move that set its stock (sweepMoves' lowestMove), its centre c at the
-//         minimiser (the same closed form), and the drop envelope there (envelope.hpp's
-//         DropCutter, depth tolerance eps = gougeTolerance / 4: the lowest height Z found from
-//         which the vertical segment up to the top is proven R - eps / 2 clear of the whole
-//         surface). When c_z >= Z - (gougeTolerance - eps / 2), the ball at c is within
-//         gougeTolerance - eps / 2 below a ball proven clear and in the air above the part, so
-//         it stands at least R - gougeTolerance from the surface and outside it: no material
-//         beyond the tolerance was cut by it, and no other move cut that point lower. Such a
-//         point is "cleared": out of the gouge figures, counted apart (clearedGougePoints).
+//         minimiser (the same closed form), and the vertical segment from c up to above the
+//         whole surface (ballTop): when SurfaceDistance::segmentClearance proves it
+//         R - gougeTolerance clear, the ball at c is that far from every surface point and
+//         joined to the air above the part (a ball inside the part, or under its edge,
+//         meets the surface on the way up), so no material deeper than gougeTolerance was
+//         cut by it, and no other move cut that point lower. Such a point is "cleared": out
+//         of the gouge figures, counted apart (clearedGougePoints). The proof is made at c
+//         itself, not by comparing c with a drop envelope: beside an edge the lowest clear
+//         height of the envelope jumps (a centre R - 1e-5 beside a steep patch's edge is
+//         clear at any height by R - 1e-4, while its exact contact stands 2e-3 above the
+//         edge), so a drop envelope found from a nearby contact would refuse a ball the
+//         direct proof clears.
 //         Arcs, and points past maxClearanceChecks, are not cleared (they count as gouges).
 //         Meshes and designs from elsewhere are not checked (their routes keep a clearance).
 // Meshes: a triangle mesh (mesh.hpp) may stand for the surface: the grid covers its
