@@ -818,6 +818,8 @@ SimulationReport simulateCut(const Surface& surface, const std::vector<SweptMove
         return [distance = sharedDistance(), clearance = radius - slack, top]() -> ClearanceTest {
           return [distance, clearance, top](Vec3 c) {
             if (c.z >= top) return true;
+            // A tolerance of R or more proves nothing of where the ball stands.
+            if (!(clearance > 0.0)) return false;
             return distance->segmentClearance(c, {c.x, c.y, top}, clearance).verdict == Clearance::proven;
           };
         };
