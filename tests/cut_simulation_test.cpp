@@ -591,6 +591,18 @@ Surface stepWithAWall() {
   return Surface{Units::inch, {top, wall, floor}};
 }
 
+// Options for a surface's gouge checks with the tool and grid given: no margin, no reach
+// classification (the tests below judge gouges only).
+SimulationOptions gougeOnlyOptions(double radius, double resolution) {
+  SimulationOptions options;
+  options.toolRadius = radius;
+  options.scallopHeight = 0.01;
+  options.resolution = resolution;
+  options.margin = 0.0;
+  options.classifyReach = false;
+  return options;
+}
+
 // Vertical walls (the contract): a ball running along the floor tangent to the wall lowers
 // the wall's grid column to its centre, a vertical "gouge" of the wall's height where the
 // ball cut nothing (its distance to the step, in closed form below, is R); those points are
@@ -599,12 +611,7 @@ Surface stepWithAWall() {
 TEST(CutSimulation, AVerticalWallGrazedByTheBallIsNoGougeButACutIntoItIs) {
   const Surface step = stepWithAWall();
   const double radius = 0.25, depth = 0.05;
-  SimulationOptions options;
-  options.toolRadius = radius;
-  options.scallopHeight = 0.01;
-  options.resolution = 1.0 / 64.0;
-  options.margin = 0.0;
-  options.classifyReach = false;
+  const SimulationOptions options = gougeOnlyOptions(radius, 1.0 / 64.0);
   // The distance from a centre to the step's faces (each a rectangle), in closed form.
   const auto stepDistance = [](Vec3 c) {
     const auto clamp = [](double t, double lo, double hi) { return std::clamp(t, lo, hi); };
@@ -695,12 +702,7 @@ TEST(CutSimulation, ASteepPatchsEdgeGrazedWithinTheToleranceIsClearedAndACutBeyo
     const double y = std::clamp((c.y + 2.0 * c.z) / 5.0, 0.0, 1.0);
     return std::hypot(c.y - y, c.z - 2.0 * y);
   };
-  SimulationOptions options;
-  options.toolRadius = radius;
-  options.scallopHeight = 0.01;
-  options.resolution = 1.0 / 128.0;
-  options.margin = 0.0;
-  options.classifyReach = false;
+  const SimulationOptions options = gougeOnlyOptions(radius, 1.0 / 128.0);
   const auto program = [&](double interference, double beside) {
     std::vector<SweptMove> moves;
     for (const double x : {0.5, 1.0, 1.5}) {
