@@ -669,6 +669,7 @@ std::size_t sweepMoves(const std::vector<SweptMove>& moves, double toolRadius, H
   // own rows. A point's height is the same sequence of minima as in one pass over the moves,
   // and a move's deepest cut the maximum over the bands: the same result, bit for bit, for
   // any number of threads.
+  for (std::size_t m = 0; m < moves.size(); ++m) requireMoveFinite(moves[m], m);  // once, not per band
   const std::size_t bands = std::clamp<std::size_t>(threadCount(), 1, std::max<std::size_t>(1, stock.rows / 16));
   std::vector<std::vector<double>> bandLowered(bands, std::vector<double>(lowered ? moves.size() : 0, 0.0));
   std::vector<std::size_t> bandVisits(bands, 0);
@@ -677,7 +678,6 @@ std::size_t sweepMoves(const std::vector<SweptMove>& moves, double toolRadius, H
     std::size_t visits = 0;
     for (std::size_t m = 0; m < moves.size(); ++m) {
       advanceStage(moves.size() + 2 * m, 3 * moves.size());  // the sweep: the rest of a simulation
-      requireMoveFinite(moves[m], m);
       const MoveShape shape(moves[m], toolRadius);
       const auto [is, js] = pointsNear(shape, toolRadius, stock);
       if (is.empty() || js.empty() || js.hi < rowLo || js.lo >= rowHi) continue;
@@ -811,10 +811,8 @@ SimulationReport simulateCut(const Surface& surface, const std::vector<SweptMove
       },
       start,
       [&]() -> std::function<ClearanceTest()> {
-        // The segment from c up to above the whole surface (R over its highest control
-        // point, and a hair), proven R - gougeTolerance clear.
-        const double highest = controlPointTop(surface);
-        const double top = highest + radius * (1.0 + 1e-9) + 1e-9 * std::abs(highest);
+        // The segment from c up to above the whole surface, proven R - gougeTolerance clear.
+        const double top = ballTop(surface, radius);
         return [distance = sharedDistance(), clearance = radius - slack, top]() -> ClearanceTest {
           return [distance, clearance, top](Vec3 c) {
             if (c.z >= top) return true;

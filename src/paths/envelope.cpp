@@ -15,6 +15,14 @@
 #include "scallop/geometry/surface.hpp"
 
 namespace scallop {
+
+// Above every control point by R: every surface point is at least R below a ball centre
+// there, so at least R away. A relative hair more for the rounding of the comparison.
+double ballTop(const Surface& surface, double radius) {
+  const double top = controlPointTop(surface);
+  return top + radius * (1.0 + 1e-9) + 1e-9 * std::abs(top);
+}
+
 namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
@@ -106,13 +114,6 @@ double localDropHeight(const BezierPatch& patch, double& u, double& v, double X,
     if (moved <= 8.0 * std::numeric_limits<double>::epsilon()) break;
   }
   return at.g;
-}
-
-// Above every control point by R: every surface point is at least R below a ball centre
-// there, so at least R away. A relative hair more for the rounding of the comparison.
-double ballTop(const Surface& surface, double radius) {
-  const double top = controlPointTop(surface);
-  return top + radius * (1.0 + 1e-9) + 1e-9 * std::abs(top);
 }
 
 double bottomOf(const Surface& surface, double radius) {

@@ -97,10 +97,10 @@
 //         gouge exceeds the tolerance is checked against the ball that cut it lowest: the
 //         line move that set its stock (sweepMoves' lowestMove), its centre c at the
 //         minimiser (the same closed form), and the vertical segment from c up to above the
-//         whole surface (ballTop): when SurfaceDistance::segmentClearance proves it
-//         R - gougeTolerance clear, the ball at c is that far from every surface point and
-//         joined to the air above the part (a ball inside the part, or under its edge,
-//         meets the surface on the way up), so no material deeper than gougeTolerance was
+//         whole surface (envelope.hpp's ballTop): when SurfaceDistance::segmentClearance
+//         proves it R - gougeTolerance clear, the ball at c is that far from every surface
+//         point and joined to the air above the part (a ball inside the part, or under its
+//         edge, meets the surface on the way up), so no material deeper than gougeTolerance was
 //         cut by it, and no other move cut that point lower. Such a point is "cleared": out
 //         of the gouge figures, counted apart (clearedGougePoints). The proof is made at c
 //         itself, not by comparing c with a drop envelope: beside an edge the lowest clear

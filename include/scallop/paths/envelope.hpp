@@ -137,6 +137,10 @@ ToolPath liftToDropEnvelope(const SurfaceDistance& distance, const ToolPath& pat
                             const EnvelopeOptions& options, EnvelopeReport& report,
                             std::vector<std::vector<std::size_t>>* moveMap = nullptr);
 
+/// The height above which a ball centre of radius R is clear of the whole surface: R (and a
+/// relative hair for rounding) above its highest control point (convex hull property).
+double ballTop(const Surface& surface, double radius);
+
 /// Drop-cutter heights: the drop envelope Z(x, y) at points one after another, each lifted
 /// from below the whole surface as liftToDropEnvelope lifts a vertex (the lowest height found
 /// within eps / 4 from which the vertical segment up to Ztop is proven R - eps / 2 clear;
