@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <numbers>
 #include <string>
 #include <unordered_map>
@@ -53,6 +54,13 @@ struct PatchTree {
   std::vector<std::vector<Vec3>> nets;
   std::vector<std::vector<Box>> boxes;
   double scale = 0.0;  // the largest |coordinate| of the patch's control points
+  // A trimmed patch's cells' places in its face (CellPlace + 1; 0: not classified yet), level
+  // after level (level L from placeOffset[L]), filled on first use by whichever thread gets
+  // there: the place is a function of the cell alone, so every thread writes the same value.
+  // Beside the cells' boxes, not in a hashed table: classifying costs a table lookup that
+  // missed the cache on every cell (a quarter of a trimmed face's plan). Null: untrimmed.
+  std::shared_ptr<std::atomic<std::uint8_t>[]> places;
+  std::vector<std::size_t> placeOffset;
 };
 
 // A node of the hierarchy of the patches' root boxes: a leaf holds `count` patches
@@ -620,6 +628,7 @@ struct CellStore {
   std::vector<Vec3> nets;   // [0, netsUsed) in use; never shrunk, so never re-zeroed
   std::size_t netsUsed = 0;
   std::vector<Box> boxes;
+  std::vector<std::uint8_t> places;  // beside boxes: a trimmed cell's place + 1 (0: not classified)
   std::size_t boxesUsed = 0;
   std::vector<Slot> slots = std::vector<Slot>(kStoreSlots);
   std::size_t entries = 0;
@@ -666,7 +675,11 @@ struct CellStore {
     }
     box = static_cast<std::uint32_t>(boxesUsed);
     boxesUsed += 4;
-    if (boxesUsed > boxes.size()) boxes.resize(std::max(boxesUsed, 2 * boxes.size()));
+    if (boxesUsed > boxes.size()) {
+      boxes.resize(std::max(boxesUsed, 2 * boxes.size()));
+      places.resize(boxes.size());
+    }
+    std::fill_n(places.begin() + box, 4, std::uint8_t{0});
     for (std::size_t k = 0; k < 4; ++k) boxes[box + k] = boxOf(nets.data() + net + k * stride, tree.points);
     if (entries < kStoreSlots / 4) {
       slots[slot] = {iu, iv, patch, depth, net, box};
@@ -1001,26 +1014,48 @@ struct TrimCellCache {
 };
 
 // A trimmed patch's cell (trims non-null and the patch trimmed, the cell not known inside):
-// false when it lies outside the face (dropped), else marks it when it lies inside.
-bool classifyForTrim(const std::vector<PatchTrim>* trims, std::uint64_t id, Cell& cell) {
+// false when it lies outside the face (dropped), else marks it when it lies inside. The place
+// is remembered beside the cell (its tree's places, or the cell store's), and the per-thread
+// table is asked only the first time: it outlives the store's cells.
+bool classifyForTrim(const std::vector<PatchTrim>* trims, std::uint64_t id, const PatchTree& tree,
+                     CellStore& store, Cell& cell) {
   if (cell.inFace) return true;
   if (trims == nullptr || !(*trims)[cell.patch].trimmed()) {
     cell.inFace = true;  // all of an untrimmed patch is surface
     return true;
   }
-  thread_local TrimCellCache cache;
-  const double h = cellSide(cell.depth);
-  const double cells = cellSide(-cell.depth);
-  const auto iu = static_cast<std::uint64_t>(cell.u0 * cells), iv = static_cast<std::uint64_t>(cell.v0 * cells);
-  TrimCellCache::Slot& slot =
-      cache.slots[static_cast<std::size_t>(mixCellKey(iu, iv, cell.patch, cell.depth) ^ (id * 0xD6E8FEB86659FD93ULL)) &
-                  (TrimCellCache::kSlots - 1)];
-  if (slot.id != id || slot.iu != iu || slot.iv != iv || slot.patch != cell.patch || slot.depth != cell.depth) {
-    slot = {id, iu, iv, cell.patch, cell.depth,
-            classifyCell((*trims)[cell.patch], ParameterCell{cell.u0, cell.u0 + h, cell.v0, cell.v0 + h})};
+  std::atomic<std::uint8_t>* treePlace = nullptr;
+  std::uint8_t* storePlace = nullptr;
+  std::uint8_t known = 0;
+  if (cell.inTree && tree.places) {
+    treePlace = &tree.places[tree.placeOffset[static_cast<std::size_t>(cell.depth)] + cell.net];
+    known = treePlace->load(std::memory_order_relaxed);
+  } else if (!cell.inTree) {
+    storePlace = &store.places[cell.box];
+    known = *storePlace;
   }
-  if (slot.place == CellPlace::outside) return false;
-  cell.inFace = slot.place == CellPlace::inside;
+  CellPlace place;
+  if (known != 0) {
+    place = static_cast<CellPlace>(known - 1);
+  } else {
+    thread_local TrimCellCache cache;
+    const double h = cellSide(cell.depth);
+    const double cells = cellSide(-cell.depth);
+    const auto iu = static_cast<std::uint64_t>(cell.u0 * cells), iv = static_cast<std::uint64_t>(cell.v0 * cells);
+    TrimCellCache::Slot& slot =
+        cache.slots[static_cast<std::size_t>(mixCellKey(iu, iv, cell.patch, cell.depth) ^ (id * 0xD6E8FEB86659FD93ULL)) &
+                    (TrimCellCache::kSlots - 1)];
+    if (slot.id != id || slot.iu != iu || slot.iv != iv || slot.patch != cell.patch || slot.depth != cell.depth) {
+      slot = {id, iu, iv, cell.patch, cell.depth,
+              classifyCell((*trims)[cell.patch], ParameterCell{cell.u0, cell.u0 + h, cell.v0, cell.v0 + h})};
+    }
+    place = slot.place;
+    const auto code = static_cast<std::uint8_t>(static_cast<std::uint8_t>(place) + 1);
+    if (treePlace != nullptr) treePlace->store(code, std::memory_order_relaxed);
+    if (storePlace != nullptr) *storePlace = code;
+  }
+  if (place == CellPlace::outside) return false;
+  cell.inFace = place == CellPlace::inside;
   return true;
 }
 
@@ -1062,7 +1097,7 @@ ClosestPoint search(const Surface& surface, double scale, const std::vector<Patc
   // only if the cell survives that; then queued or set aside.
   const auto offer = [&](Cell cell, unsigned fresh) {
     ++cells;
-    if (!classifyForTrim(trims, id, cell)) return;
+    if (!classifyForTrim(trims, id, trees[cell.patch], store, cell)) return;
     const PatchTree& tree = trees[cell.patch];
     const Vec3* net = cellNet(tree, cell, store);
     const Box box = cornersAndBox(tree, cell, net, fresh, store, consider);
@@ -1242,7 +1277,7 @@ SegmentClearance segmentSearch(const std::vector<PatchTree>& trees, const std::v
   };
   const auto offer = [&](Cell cell, unsigned fresh) {
     ++result.cells;
-    if (!classifyForTrim(trims, id, cell)) return;
+    if (!classifyForTrim(trims, id, trees[cell.patch], store, cell)) return;
     const PatchTree& tree = trees[cell.patch];
     const Vec3* net = cellNet(tree, cell, store);
     const Box box = cornersAndBox(tree, cell, net, fresh, store, consider);
@@ -1467,6 +1502,15 @@ SurfaceDistance::SurfaceDistance(const Surface& surface, const DistanceOptions& 
   trees_.reserve(surface_.patches.size());
   for (const BezierPatch& patch : surface_.patches) {
     trees_.push_back(buildTree(patch, depth));
+    PatchTree& tree = trees_.back();
+    if (surface_.trimmed() && surface_.trims[trees_.size() - 1].trimmed()) {
+      std::size_t cells = 0;
+      for (int level = 0; level < tree.levels; ++level) {
+        tree.placeOffset.push_back(cells);
+        cells += std::size_t{1} << (2 * level);
+      }
+      tree.places = std::shared_ptr<std::atomic<std::uint8_t>[]>(new std::atomic<std::uint8_t>[cells]());  // all 0
+    }
   }
   buildHierarchy(trees_, nodes_, nodePatches_);
 }
