@@ -13,11 +13,11 @@
 #include <fmt/format.h>
 
 #include "scallop/error.hpp"
+#include "scallop/geometry/tolerances.hpp"
 
 namespace scallop {
 namespace {
 
-constexpr double kUnitRoundoff = std::numeric_limits<double>::epsilon() / 2;  // u = 2^-53
 // Running error bounds are themselves computed in floating point; scaling the propagated
 // part by (1 + 4u) per step and adding the smallest subnormal (the absolute error of halving
 // a subnormal) keeps them upper bounds despite their own rounding.

@@ -13,11 +13,11 @@
 #include <fmt/format.h>
 
 #include "scallop/error.hpp"
+#include "scallop/geometry/tolerances.hpp"
 
 namespace scallop {
 namespace {
 
-constexpr double kUnitRoundoff = std::numeric_limits<double>::epsilon() / 2;  // u = 2^-53
 
 void requireValid(const BezierPatch& patch, const char* what) {
   if (patch.degreeU < 1 || patch.degreeV < 1) {

@@ -24,6 +24,7 @@
 
 #include "scallop/geometry/bernstein.hpp"
 #include "scallop/error.hpp"
+#include "scallop/geometry/tolerances.hpp"
 
 namespace scallop {
 namespace {
@@ -59,7 +60,6 @@ std::string shortest(double value) {
 // Regularity: f = |r_u x r_v|^2 in Bernstein form, quadtree
 // ---------------------------------------------------------------------------------------
 
-constexpr double kUnitRoundoff = std::numeric_limits<double>::epsilon() / 2.0;
 
 // Rounding allowances of the two certificates after `depth` quadtree levels, from the error
 // bounds documented in bernstein.hpp (u = unit roundoff; P-bar = the same combination of

@@ -24,6 +24,7 @@
 #include <fmt/format.h>
 
 #include "scallop/error.hpp"
+#include "scallop/geometry/tolerances.hpp"
 #include "scallop/job_control.hpp"
 #include "scallop/parallel.hpp"
 
@@ -84,7 +85,6 @@ using detail::Box;
 using detail::PatchNode;
 using detail::PatchTree;
 
-constexpr double kUnitRoundoff = std::numeric_limits<double>::epsilon() / 2;  // u = 2^-53
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 constexpr int kMaxTreeDepth = 6;
 

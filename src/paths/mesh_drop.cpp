@@ -11,13 +11,13 @@
 #include <fmt/format.h>
 
 #include "scallop/error.hpp"
+#include "scallop/geometry/tolerances.hpp"
 
 namespace scallop {
 
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kUnit = std::numeric_limits<double>::epsilon() / 2.0;  // u = 2^-53
 
 double maxAbs(Vec3 p) { return std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)}); }
 bool finite(Vec3 p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z); }
@@ -320,7 +320,7 @@ std::int32_t MeshDropCutter::cellY(double y) const {
 // The rounding allowance of a distance computed from coordinates up to S: a few tens of
 // operations each within u of the running magnitude (S + R).
 double MeshDropCutter::allowance(Vec3 a, Vec3 b) const {
-  return 64.0 * kUnit * (std::max({maxAbs_, maxAbs(a), maxAbs(b)}) + radius_);
+  return 64.0 * kUnitRoundoff * (std::max({maxAbs_, maxAbs(a), maxAbs(b)}) + radius_);
 }
 
 MeshContact MeshDropCutter::drop(double x, double y) const {

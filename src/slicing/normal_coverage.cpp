@@ -19,11 +19,11 @@
 #include "scallop/geometry/bernstein.hpp"
 #include "scallop/geometry/bezier.hpp"
 #include "scallop/error.hpp"
+#include "scallop/geometry/tolerances.hpp"
 
 namespace scallop {
 namespace {
 
-constexpr double kUnitRoundoff = std::numeric_limits<double>::epsilon() / 2.0;
 constexpr double kSqrt3 = 1.7320508075688772;
 constexpr double kHalfPi = std::numbers::pi / 2.0;
 // Normals of a rectangle must stay this far (radians) inside the chart's hemisphere: the
