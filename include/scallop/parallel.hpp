@@ -8,7 +8,7 @@
 // simulation's clearance and reach checks; the exact heights of a CAD part) takes its thread
 // count from its options' `threads` field where it has one (0 there means threadCount()
 // below), else threadCount(). Each of them writes only its own slots and combines them in a fixed
-// order, so results are the same, bit for bit, for every thread count (tests/cli_test.cpp
+// order, so results are the same, bit for bit, for every thread count (tests/cli/cli_test.cpp
 // compares the files every command writes at 1 and 2 threads).
 //
 // threadCount(): the process-wide default, set by setThreadCount (the CLI's `--threads N`);

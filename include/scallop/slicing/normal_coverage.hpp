@@ -136,7 +136,7 @@
 //         and assembly tests, each O(mn(m + n)) per rectangle for the restriction plus
 //         O(samples) for the winding; budgets: maxCaps caps and maxCells rectangle tests
 //         (past either: not proven, reason budget). Deterministic: the same input gives the
-//         same result. Measured (tests/normal_coverage_test.cpp, default options, Release,
+//         same result. Measured (tests/slicing/normal_coverage_test.cpp, default options, Release,
 //         2 shared cores): closed C2 tori of 32 bicubic patches 0.05 - 0.07 s, the teapot
 //         (32 patches) 0.17 s, its lid 0.84 s, its bottom 0.25 s, its rim 0.02 s.
 

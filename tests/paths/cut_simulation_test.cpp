@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "mesh_fixtures.hpp"
+#include "support/mesh_fixtures.hpp"
 #include "scallop/paths/contour.hpp"
 #include "scallop/paths/cut_simulation.hpp"
 #include "scallop/paths/envelope.hpp"
@@ -27,7 +27,7 @@
 #include "scallop/paths/raster.hpp"
 #include "scallop/geometry/surface.hpp"
 #include "scallop/io/verify_output.hpp"
-#include "rational_patches.hpp"
+#include "support/rational_patches.hpp"
 
 namespace scallop {
 namespace {

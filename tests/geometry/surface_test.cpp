@@ -19,8 +19,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "corner_patches.hpp"
-#include "message_checks.hpp"
+#include "support/corner_patches.hpp"
+#include "support/message_checks.hpp"
 #include "scallop/geometry/bernstein.hpp"
 #include "scallop/geometry/bezier.hpp"
 #include "scallop/error.hpp"

@@ -22,8 +22,8 @@
 #include "scallop/paths/gouge.hpp"
 #include "scallop/geometry/surface.hpp"
 #include "scallop/paths/toolpath.hpp"
-#include "distance_reference.hpp"
-#include "rational_patches.hpp"
+#include "support/distance_reference.hpp"
+#include "support/rational_patches.hpp"
 
 namespace scallop {
 namespace {

@@ -17,7 +17,7 @@
 #include <utility>
 #include <vector>
 
-#include "cli_fixture.hpp"
+#include "support/cli_fixture.hpp"
 #include "scallop/error.hpp"
 #include "scallop/job_control.hpp"
 #include "scallop/geometry/surface.hpp"

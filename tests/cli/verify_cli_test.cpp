@@ -10,7 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cli_fixture.hpp"
+#include "support/cli_fixture.hpp"
 
 namespace scallop::test {
 namespace {

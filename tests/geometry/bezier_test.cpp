@@ -51,7 +51,7 @@
 #include "scallop/geometry/bezier.hpp"
 #include "scallop/error.hpp"
 #include "scallop/geometry/vector.hpp"
-#include "rational_patches.hpp"
+#include "support/rational_patches.hpp"
 
 namespace {
 

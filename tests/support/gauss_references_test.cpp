@@ -12,7 +12,7 @@
 #include <numbers>
 #include <vector>
 
-#include "gauss_references.hpp"
+#include "support/gauss_references.hpp"
 #include "scallop/geometry/bezier.hpp"
 #include "scallop/geometry/surface.hpp"
 

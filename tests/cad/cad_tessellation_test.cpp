@@ -46,9 +46,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cad_fixtures.hpp"
-#include "cli_fixture.hpp"
-#include "message_checks.hpp"
+#include "support/cad_fixtures.hpp"
+#include "support/cli_fixture.hpp"
+#include "support/message_checks.hpp"
 #include "scallop/cad/cad_import.hpp"
 #include "scallop/cad/cad_tessellation.hpp"
 #include "scallop/geometry/face_trim.hpp"

@@ -22,8 +22,8 @@
 #include "scallop/slicing/stereographic.hpp"
 #include "scallop/geometry/surface.hpp"
 #include "scallop/io/surface_io.hpp"
-#include "corner_patches.hpp"
-#include "gauss_references.hpp"
+#include "support/corner_patches.hpp"
+#include "support/gauss_references.hpp"
 
 namespace {
 
@@ -233,7 +233,7 @@ TEST(GaussMap, RandomMultiPatchSurfacesKeepEveryNormal) {
             << worst / kDeg << " deg; " << boundary << " boundary points checked\n";
 }
 
-// Random patches with singular corners (tests/corner_patches.hpp), alone and three side by
+// Random patches with singular corners (tests/support/corner_patches.hpp), alone and three side by
 // side: the arcs of the normal's limits at the corners (rays sampled 1e-6 inside) and every
 // other sampled normal lie in Omega, and membership says yes to them.
 TEST(GaussMap, SingularCornerPatchesKeepEveryNormal) {

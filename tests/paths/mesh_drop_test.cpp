@@ -36,7 +36,7 @@
 #include <string>
 #include <vector>
 
-#include "mesh_fixtures.hpp"
+#include "support/mesh_fixtures.hpp"
 #include "scallop/error.hpp"
 #include "scallop/geometry/mesh.hpp"
 

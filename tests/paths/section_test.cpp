@@ -19,7 +19,7 @@
 #include "scallop/error.hpp"
 #include "scallop/paths/section.hpp"
 #include "scallop/geometry/surface.hpp"
-#include "rational_patches.hpp"
+#include "support/rational_patches.hpp"
 
 namespace {
 

@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "gauss_references.hpp"
-#include "rational_patches.hpp"
+#include "support/gauss_references.hpp"
+#include "support/rational_patches.hpp"
 #include "scallop/geometry/bezier.hpp"
 #include "scallop/error.hpp"
 #include "scallop/slicing/mesh_slicing.hpp"

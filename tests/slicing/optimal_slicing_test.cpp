@@ -20,8 +20,8 @@
 #include "scallop/slicing/optimal_slicing.hpp"
 #include "scallop/slicing/stereographic.hpp"
 #include "scallop/geometry/surface.hpp"
-#include "corner_patches.hpp"
-#include "gauss_references.hpp"
+#include "support/corner_patches.hpp"
+#include "support/gauss_references.hpp"
 
 namespace {
 

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "distance_reference.hpp"
+#include "support/distance_reference.hpp"
 #include "scallop/paths/contour.hpp"
 #include "scallop/paths/cut_simulation.hpp"
 #include "scallop/error.hpp"

@@ -23,7 +23,7 @@
 #include "scallop/error.hpp"
 #include "scallop/paths/raster.hpp"
 #include "scallop/geometry/surface.hpp"
-#include "distance_reference.hpp"
+#include "support/distance_reference.hpp"
 
 namespace {
 
@@ -431,7 +431,7 @@ Checked checkRaster(const Surface& surface, const RasterPaths& r, double angle, 
 }
 
 // The scallop hull's paths as they are, exact in their planes (the stage the checker above
-// judges); the drop envelope on top is tests/envelope_test.cpp's.
+// judges); the drop envelope on top is tests/paths/envelope_test.cpp's.
 RasterPaths run(const Surface& s, double angle, double R, double spacing) {
   RasterOptions o;
   o.dropEnvelope = false;

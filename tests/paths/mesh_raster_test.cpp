@@ -14,7 +14,7 @@
 #include <utility>
 #include <vector>
 
-#include "mesh_fixtures.hpp"
+#include "support/mesh_fixtures.hpp"
 #include "scallop/paths/cut_simulation.hpp"
 #include "scallop/error.hpp"
 #include "scallop/geometry/mesh.hpp"

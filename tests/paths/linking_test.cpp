@@ -5,7 +5,7 @@
 // The judge: the ball's centre sampled every R / 16 along each move of each link (the rise,
 // the traverse and the descent of a local retract; the straight feed of a direct link; the
 // descent into the first pass), its distance to the surface taken from
-// tests/distance_reference.hpp (a dense grid and a pattern search, sharing nothing with
+// tests/support/distance_reference.hpp (a dense grid and a pattern search, sharing nothing with
 // gouge.hpp's branch and bound). The reference distance is attained by a surface point, so
 // when it says a centre is too close, it is. Limits: R - a at a move that starts or ends at a
 // pass end whose own depth is a (the contract: never deeper than at the ends, plus epsilon),
@@ -24,7 +24,7 @@
 #include <string>
 #include <vector>
 
-#include "distance_reference.hpp"
+#include "support/distance_reference.hpp"
 #include "scallop/paths/contour.hpp"
 #include "scallop/error.hpp"
 #include "scallop/io/gcode.hpp"

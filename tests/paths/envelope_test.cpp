@@ -1,5 +1,5 @@
 // The drop envelope (envelope.hpp) and the segment clearance test under it (gouge.hpp),
-// judged by tests/distance_reference.hpp: every patch sampled on a grid and refined by a
+// judged by tests/support/distance_reference.hpp: every patch sampled on a grid and refined by a
 // derivative-free pattern search, written independently of gouge.cpp. Its distance is
 // attained by a surface point, so it is never below the true distance.
 
@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "distance_reference.hpp"
+#include "support/distance_reference.hpp"
 #include "scallop/paths/contour.hpp"
 #include "scallop/paths/cut_simulation.hpp"
 #include "scallop/paths/envelope.hpp"

@@ -15,10 +15,10 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "cli_fixture.hpp"
-#include "rs274.hpp"
-#include "distance_reference.hpp"
-#include "rational_patches.hpp"
+#include "support/cli_fixture.hpp"
+#include "support/rs274.hpp"
+#include "support/distance_reference.hpp"
+#include "support/rational_patches.hpp"
 #include "scallop/geometry/bezier.hpp"
 #include "scallop/paths/cut_simulation.hpp"
 #include "scallop/io/gcode_reader.hpp"

@@ -44,7 +44,7 @@
 #include <unistd.h>
 #include <vector>
 
-#include "rs274.hpp"
+#include "support/rs274.hpp"
 #include "scallop/paths/contour.hpp"
 #include "scallop/error.hpp"
 #include "scallop/io/gcode.hpp"

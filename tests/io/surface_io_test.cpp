@@ -19,8 +19,8 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "cli_fixture.hpp"
-#include "message_checks.hpp"
+#include "support/cli_fixture.hpp"
+#include "support/message_checks.hpp"
 #include "scallop/error.hpp"
 #include "scallop/geometry/surface.hpp"
 #include "scallop/io/surface_io.hpp"

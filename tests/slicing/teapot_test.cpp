@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "gauss_references.hpp"
+#include "support/gauss_references.hpp"
 #include "scallop/error.hpp"
 #include "scallop/slicing/optimal_slicing.hpp"
 #include "scallop/geometry/surface.hpp"

@@ -17,7 +17,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cli_fixture.hpp"
+#include "support/cli_fixture.hpp"
 #include "scallop/geometry/mesh.hpp"
 #include "scallop/slicing/mesh_slicing.hpp"
 #include "scallop/slicing/optimal_slicing.hpp"

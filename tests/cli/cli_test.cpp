@@ -20,7 +20,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cli_fixture.hpp"
+#include "support/cli_fixture.hpp"
 #include "scallop/paths/chain.hpp"
 #include "scallop/io/chain_io.hpp"
 #include "scallop/geometry/surface.hpp"

@@ -13,8 +13,8 @@
 
 #include <fmt/format.h>
 
-#include "message_checks.hpp"
-#include "rs274.hpp"
+#include "support/message_checks.hpp"
+#include "support/rs274.hpp"
 #include "scallop/error.hpp"
 #include "scallop/io/gcode.hpp"
 #include "scallop/io/gcode_reader.hpp"
