@@ -16,7 +16,7 @@
 // per gouge sample block, per simulated grid row, per run-on search step, per Gauss-map cell.
 // Once a poll sees the flag it throws scallop::Cancelled, which unwinds the call: it returns
 // no result, and whatever files the caller writes at the end are not written.
-// tests/job_control_test.cpp cancels plans at spread moments and measures how long they take
+// tests/jobs/plan_test.cpp cancels plans at spread moments and measures how long they take
 // to stop; the README gives the figures.
 //
 // Progress: the callback receives (fraction, stage) on the thread that called, never on a

@@ -600,7 +600,7 @@ double judgeContour(const Surface& s, const Vec3& n, double radius, double h,
   return judgeScallop(s, paths.path, radius, n, wLo, wHi, 0.03, 24, 800, 10.0 * h);
 }
 
-class CuspJudge : public ::testing::TestWithParam<std::pair<const char*, double>> {};
+class CuspJudge : public ::testing::TestWithParam<std::pair<std::string, double>> {};
 
 // The adaptive offsets keep the real scallop (the lower envelope of the swept balls) below
 // H within 5 %: the osculating-circle model's second-order error and the chords' H / 20.
@@ -615,14 +615,14 @@ TEST_P(CuspJudge, AdaptiveContourScallopStaysBelowH) {
   const scallop::AdaptiveOffsets a = scallop::adaptivePlaneOffsets(s, paperNormal(name), cusp);
   const double judged = judgeContour(s, paperNormal(name), radius, h, a.offsets, 0.0);
   if (std::getenv("CUSP_DEBUG"))
-    std::printf("%s R %g judged %.6g planes %zu\n", name, radius, judged, a.offsets.size());
+    std::printf("%s R %g judged %.6g planes %zu\n", name.c_str(), radius, judged, a.offsets.size());
   EXPECT_LE(judged, 1.05 * h) << name << " R " << radius;
   EXPECT_GE(judged, 0.5 * h) << name << " R " << radius << ": steps needlessly small";
 }
 
 INSTANTIATE_TEST_SUITE_P(PaperSurfaces, CuspJudge,
-                         ::testing::Values(std::pair{"paper-1", 0.25}, std::pair{"paper-1", 1.0},
-                                           std::pair{"paper-2", 0.25}, std::pair{"paper-2", 1.0}),
+                         ::testing::Values(std::pair{std::string("paper-1"), 0.25}, std::pair{std::string("paper-1"), 1.0},
+                                           std::pair{std::string("paper-2"), 0.25}, std::pair{std::string("paper-2"), 1.0}),
                          [](const auto& param) {
                            std::string name = param.param.first;
                            name.erase(std::remove(name.begin(), name.end(), '-'), name.end());
@@ -806,7 +806,7 @@ double judgeRasterScallop(const Surface& s, const RasterBalls& balls,
   return worst;
 }
 
-class CuspCentrePlanes : public ::testing::TestWithParam<std::tuple<const char*, double, double>> {};
+class CuspCentrePlanes : public ::testing::TestWithParam<std::tuple<std::string, double, double>> {};
 
 // The adaptive offsets for raster (centre planes) and, to compare, the contact-plane model's.
 std::pair<scallop::AdaptiveOffsets, scallop::AdaptiveOffsets> centreAndContactOffsets(
@@ -843,15 +843,16 @@ TEST_P(CuspCentrePlanes, AdaptiveRasterScallopStaysBelowH) {
                                            30, 600);
   std::printf("[          ] %s R %g angle %g: %zu centre planes (%zu contact planes), %zu moves; model's worst "
               "%.4g H, judged %.4g H\n",
-              name, radius, angle, a.offsets.size(), contact.offsets.size(), balls.moves(), model / h, judged / h);
+              name.c_str(), radius, angle, a.offsets.size(), contact.offsets.size(), balls.moves(), model / h, judged / h);
   EXPECT_LE(judged, 1.05 * h);
   EXPECT_GE(judged, 0.5 * h) << "steps needlessly small";
   EXPECT_LE(a.offsets.size(), 2 * contact.offsets.size());
 }
 
 INSTANTIATE_TEST_SUITE_P(PaperSurfaces, CuspCentrePlanes,
-                         ::testing::Values(std::tuple{"paper-1", 0.25, 0.0}, std::tuple{"paper-1", 1.0, 0.0},
-                                           std::tuple{"paper-2", 0.25, 1.0}),
+                         ::testing::Values(std::tuple{std::string("paper-1"), 0.25, 0.0},
+                                           std::tuple{std::string("paper-1"), 1.0, 0.0},
+                                           std::tuple{std::string("paper-2"), 0.25, 1.0}),
                          [](const auto& param) {
                            std::string name = std::get<0>(param.param);
                            name.erase(std::remove(name.begin(), name.end(), '-'), name.end());
