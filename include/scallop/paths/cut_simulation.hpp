@@ -215,7 +215,7 @@ struct SimulationOptions {
   /// Clear vertical gouges on a Surface by the drop envelope at the centre that cut them
   /// lowest (see the contract's Vertical walls); false: every one counts.
   bool clearVerticalGouges = true;
-  /// Budget of those checks (one drop-cutter height each); past it the rest count as gouges.
+  /// Budget of those checks (one segment-clearance proof each); past it the rest count as gouges.
   std::size_t maxClearanceChecks = 200'000;
   std::size_t maxPoints = 4'000'000;  ///< grid budget (three doubles per point: 96 MB)
   /// Sweep budget: the (move, grid point) pairs in the moves' boxes grown by R, summed
