@@ -3,7 +3,6 @@
 // each section's tool path from the scallop hull's offset), as JSON, G-code and/or a figure.
 // Every output is computed first and the files are written all or nothing.
 
-#include <chrono>
 #include <cstdio>
 #include <memory>
 #include <optional>
@@ -24,6 +23,7 @@
 #include "surface_options.hpp"
 #include "linking_options.hpp"
 #include "mesh_job.hpp"
+#include "scallop/jobs/mesh_plan.hpp"
 #include "scallop/jobs/toolpath_job.hpp"
 
 namespace scallop::cli {
@@ -55,16 +55,25 @@ struct PathsOptions {
   std::string deflection;     // --deflection D: that tessellation's
 };
 
-// What paths asks of a mesh raster (its progress lines off: paths prints one summary).
-MeshRasterRequest meshRequest(const PathsOptions& options) {
-  return {sourceName(options.surface), "paths", options.toolRadius, options.scallopHeight, options.spacing, true};
+// What paths asks of a mesh raster, parsed (the strings' errors name the option).
+MeshPlanOptions meshPathsOptions(const PathsOptions& options) {
+  MeshPlanOptions job;
+  job.source = sourceName(options.surface);
+  job.toolRadius = parsePositive(options.toolRadius, "tool radius", "a positive length");
+  if (!options.spacing.empty()) {
+    job.spacing = parsePositive(options.spacing, "spacing", "a positive length");
+  } else {
+    job.scallopHeight = parsePositive(options.scallopHeight, "scallop height", "a positive length");
+  }
+  return job;
 }
 
-// `paths` on a triangle mesh (an STL file, or a STEP/IGES part's tessellation): the raster of
-// exact drop lines (mesh_job.hpp), every move proven, as JSON and G-code.
-void runPathsMesh(const PathsOptions& options, const MeshJob& job) {
+// `paths` on a triangle mesh (an STL file, or a STEP/IGES part's tessellation: `part`): the
+// library's raster of exact drop lines (mesh_plan.hpp's meshToolpaths), every move proven, as
+// JSON and G-code.
+void runPathsMesh(const PathsOptions& options, const Mesh& mesh, const TessellatedPart* part) {
   const std::string source = sourceName(options.surface);
-  const char* const what = job.part ? "a tessellated part" : "a mesh";
+  const char* const what = part != nullptr ? "a tessellated part" : "a mesh";
   const auto reject = [&](bool given, const char* option, const char* why) {
     if (given) throw Error(fmt::format("{}: {} {}; not for {}", source, option, why, what));
   };
@@ -78,32 +87,33 @@ void runPathsMesh(const PathsOptions& options, const MeshJob& job) {
   reject(options.noLinking || options.oneWay, "--no-linking/--one-way", "order a surface plan's passes (a mesh's raster is one zigzag)");
   reject(options.noGougeCheck, "--no-gouge-check", "skips a surface's sampled check (a mesh's moves are all proven exactly)");
   reject(!options.svgPath.empty(), "--svg", "draws a surface's sections (scallop plan draws a mesh's simulated cut)");
-  MeshRasterResult raster = runMeshRaster(job, meshRequest(options));
-  const Units units = job.mesh.units;
+  const MeshPlanOptions job = meshPathsOptions(options);
+  const Units units = mesh.units;
   const double rapidRate = options.rapidRate.empty()
                                ? defaultRapidRate(units)
                                : parsePositive(options.rapidRate, "rapid rate", "a positive rate");
+  MeshToolpathResult raster = part != nullptr ? meshToolpaths(*part, job) : meshToolpaths(mesh, job);
   const GcodeDialect dialect = gcodeDialect(options.dialect);
-  const GcodeOptions gcodeOptions =
-      defaultGcodeOptions(units, raster.top, raster.paths.path, dialect, fmt::format("scallop paths raster {}", source));
+  const GcodeOptions gcodeOptions = defaultGcodeOptions(units, raster.partTop, raster.raster.path, dialect,
+                                                        fmt::format("scallop paths raster {}", source));
   PathsReport& report = raster.report;
-  report.motion = gcodeMotion(raster.paths.path, gcodeOptions, rapidRate);
+  report.motion = gcodeMotion(raster.raster.path, gcodeOptions, rapidRate);
   report.feedRate = gcodeOptions.feedRate;
   report.plungeFeedRate = gcodeOptions.plungeFeedRate;
   report.rapidRate = rapidRate;
-  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - raster.start).count();
   std::vector<OutputFile> outputs;
   const bool anyOutput = !options.jsonPath.empty() || !options.gcodePath.empty();
   const std::string jsonPath = anyOutput ? options.jsonPath : std::string(kStandardStream);
-  if (!jsonPath.empty()) outputs.push_back({jsonPath, pathsToJson(report, raster.paths.path)});
-  if (!options.gcodePath.empty()) outputs.push_back({options.gcodePath, gcodeProgram(raster.paths.path, gcodeOptions)});
+  if (!jsonPath.empty()) outputs.push_back({jsonPath, pathsToJson(report, raster.raster.path)});
+  if (!options.gcodePath.empty())
+    outputs.push_back({options.gcodePath, gcodeProgram(raster.raster.path, gcodeOptions)});
   writeOutputs(outputs, "");
   if (jsonPath != kStandardStream) {
     fmt::print(stderr,
                "scallop: {}: raster paths on {} triangles, {} lines {:.6g} to {:.6g} apart, tool-centre length {:.6g} "
                "{}, every move proven (deepest ball interference {:.3g}, exact); {}; {:.3f} s\n",
-               source, job.mesh.triangles.size(), raster.paths.lines, raster.paths.minSpacing, report.spacing,
-               raster.paths.centreLength, unitsName(units), report.gouge->maxDepth, cycleSummary(report, units),
+               source, mesh.triangles.size(), raster.raster.lines, raster.raster.minSpacing, report.spacing,
+               raster.raster.centreLength, unitsName(units), report.gouge->maxDepth, cycleSummary(report, units),
                report.seconds);
   }
 }
@@ -122,19 +132,18 @@ void runPaths(const PathsOptions& options) {
       throw Error(fmt::format("{}: --tessellate and --deflection are for STEP and IGES parts; an STL file is a mesh "
                               "already",
                               sourceName(options.surface)));
-    MeshJob mesh;
-    mesh.mesh = loadStlMesh(options.surface.input, options.units, options.dropZeroArea).mesh;
-    return runPathsMesh(options, mesh);
+    const Mesh mesh = loadStlMesh(options.surface.input, options.units, options.dropZeroArea).mesh;
+    return runPathsMesh(options, mesh, nullptr);
   }
   if (!options.units.empty() || options.dropZeroArea)
     throw Error("--units and --drop-zero-area are for STL meshes (a .stl file); a surface's units are in its file");
   const CadRoute route = cadRoute(options.surface, options.tessellate, options.deflection, exactRationalFaces(options.surface));
   if (route.tessellate) {
-    MeshRasterRequest request = meshRequest(options);
-    request.quiet = options.jsonPath.empty() && options.gcodePath.empty();  // JSON on stdout: stderr quiet too
-    MeshJob mesh = tessellatedJob(*route.part, route.exact, request, options.deflection);
-    mesh.part = &*route.part;
-    return runPathsMesh(options, mesh);
+    const bool quiet = options.jsonPath.empty() && options.gcodePath.empty();  // JSON on stdout: stderr quiet too
+    announceTessellation(*route.part, route.exact, "paths", quiet);
+    const TessellatedPart part =
+        tessellatedJob(*route.part, meshPathsOptions(options), options.deflection, "paths", quiet);
+    return runPathsMesh(options, part.mesh, &part);
   }
   const std::string strategy = options.strategy.empty() ? "contour" : options.strategy;
   if (strategy == "contour" && !options.angle.empty())

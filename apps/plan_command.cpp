@@ -7,11 +7,12 @@
 //   paths-plan.svg      the same seen from above
 //   gauss-map.svg       the symmetrized Gauss map and the optimal circle on the sphere
 //   stereographic.svg   the stereographic plane with the medial axis and the optimal circle
-// Everything is computed first; the folder is written all or nothing.
+// Everything is computed first (plan.hpp's scallop::plan); the folder is written all or
+// nothing. A triangle mesh (an STL file, or a STEP/IGES part through its tessellation) is
+// planned by mesh_plan.hpp's scallop::planMesh, which writes the G-code, report.json and
+// verify.svg.
 
 #include <algorithm>
-#include <chrono>
-#include <limits>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -27,21 +28,16 @@
 #include "commands.hpp"
 #include "output_directory.hpp"
 #include "scallop/cad/cad_tessellation.hpp"
-#include "scallop/paths/cut_simulation.hpp"
 #include "scallop/error.hpp"
 #include "scallop/io/gcode.hpp"
-#include "scallop/io/gcode_reader.hpp"
 #include "scallop/slicing/optimal_slicing.hpp"
-#include "scallop/paths/mesh_raster.hpp"
-#include "scallop/paths/mesh_drop.hpp"
 #include "scallop/io/orient_output.hpp"
 #include "scallop/io/paths_output.hpp"
-#include "scallop/paths/rest_finishing.hpp"
-#include "scallop/io/verify_output.hpp"
 #include "scallop/geometry/surface.hpp"
 #include "surface_options.hpp"
 #include "linking_options.hpp"
 #include "mesh_job.hpp"
+#include "scallop/jobs/mesh_plan.hpp"
 #include "scallop/jobs/plan.hpp"
 
 namespace scallop::cli {
@@ -71,9 +67,6 @@ struct PlanArguments {
   bool tessellate = false;    // --tessellate: a STEP/IGES part cut through its tessellation
   std::string deflection;     // --deflection D: that tessellation's
 };
-
-// Rounds of rest finishing at most (each a simulation of the whole program more).
-constexpr int kRestRounds = 2;
 
 // "; rest finishing: ..." when rest passes were added (what the strategies left, what it took).
 std::string restSummary(const PathsReport& report, Units units) {
@@ -108,145 +101,48 @@ void rejectMeshOptions(const PlanArguments& options, const char* what) {
   reject(options.noLinking || options.oneWay, "--no-linking/--one-way", "order a surface plan's passes (a mesh's raster is one zigzag)");
 }
 
-// What plan asks of a mesh raster.
-MeshRasterRequest meshRequest(const PlanArguments& options) {
-  return {sourceName(options.surface), "plan", options.toolRadius, options.scallopHeight, options.spacing,
-          options.quiet};
+// What plan asks of a mesh plan, parsed (the strings' errors name the option).
+MeshPlanOptions meshPlanOptions(const PlanArguments& options) {
+  MeshPlanOptions job;
+  job.source = sourceName(options.surface);  // "<stdin>" for "-"
+  if (!options.toolRadius.empty())
+    job.toolRadius = parsePositive(options.toolRadius, "tool radius", "a positive length");
+  if (!options.spacing.empty()) {
+    job.spacing = parsePositive(options.spacing, "spacing", "a positive length");
+  } else if (!options.scallopHeight.empty()) {
+    job.scallopHeight = parsePositive(options.scallopHeight, "scallop height", "a positive length");
+  }
+  job.restFinishing = !options.noRestFinishing;
+  job.dialect = gcodeDialect(options.dialect);
+  if (!options.rapidRate.empty()) job.rapidRate = parsePositive(options.rapidRate, "rapid rate", "a positive rate");
+  return job;
 }
 
-// `plan` on an STL mesh: raster passes of exact drop lines (mesh_raster.hpp), every move proven
-// within eps; the program written and its cut simulated on the mesh itself.
-void runPlanMesh(const PlanArguments& options, MeshJob job) {
-  const std::string path = sourceName(options.surface);  // "<stdin>" for "-"
-  const char* const what = job.part ? "a tessellated part" : "a mesh";
-  rejectMeshOptions(options, what);
-  auto progress = [&](const std::string& line) {
-    if (!options.quiet) fmt::print(stderr, "scallop plan: {}...\n", line);
-  };
-  MeshRasterResult raster = runMeshRaster(job, meshRequest(options));
-  const Mesh& mesh = job.mesh;
-  const std::optional<double> height = raster.report.scallopHeight;
-  const double spacing = raster.report.spacing;
-  const double top = raster.top;
-  SimulationOptions& simulation = raster.simulation;
-  MeshRasterPaths& paths = raster.paths;
-  PathsReport& report = raster.report;
-  const auto start = raster.start;
-  const double rapidRate = options.rapidRate.empty()
-                               ? defaultRapidRate(mesh.units)
-                               : parsePositive(options.rapidRate, "rapid rate", "a positive rate");
-
-  progress("writing the G-code");
-  const GcodeDialect dialect = gcodeDialect(options.dialect);
-  const std::string title = fmt::format("scallop plan raster {}", path);
-  const std::string programName = dialect == GcodeDialect::grbl ? "toolpath.gcode" : "toolpath.ngc";
-  // A tessellated part's exact design is computed once, for every simulation of the program.
-  std::optional<std::pair<HeightGrid, std::vector<double>>> exactDesign;
-  GcodeOptions gcodeOptions;
-  std::string program;
-  const auto writeAndSimulate = [&]() -> SimulationReport {
-    gcodeOptions = defaultGcodeOptions(mesh.units, top, paths.path, dialect, title);
-    program = gcodeProgram(paths.path, gcodeOptions);
-    const GcodeProgram written = parseGcodeProgram(program, programName);
-    if (job.part) {
-      HeightGrid grid = simulationGrid(mesh, simulation);
-      if (grid.z.size() <= kExactDesignRays) {
-        if (!exactDesign) {
-          progress(fmt::format("the part's exact heights on {} x {} vertical lines", grid.columns, grid.rows));
-          HeightGrid heights = grid;
-          std::vector<double> normalZ;
-          job.part->designHeights(heights, &normalZ);
-          exactDesign.emplace(std::move(heights), std::move(normalZ));
-        }
-        progress("simulating the cut of the program on the part's exact faces");
-        report.tessellation->exactDesign = true;
-        return verifyProgram(
-            mesh.units, std::move(grid), top,
-            [&exactDesign](HeightGrid& g, std::vector<double>& normalZ) {
-              g.z = exactDesign->first.z;
-              normalZ = exactDesign->second;
-            },
-            written, simulation, &mesh);
-      }
-      progress(fmt::format("the simulation's {} x {} grid exceeds the budget of {} lines through the exact faces: "
-                           "simulating the cut on the mesh",
-                           grid.columns, grid.rows, kExactDesignRays));
-    } else {
-      progress("simulating the cut of the program on the mesh (scallop verify)");
-    }
-    return verifyProgram(mesh, written, simulation);
-  };
-  SimulationReport simulated = writeAndSimulate();
-  // Rest finishing (rest_finishing.hpp): where the simulated cut leaves more than H on points
-  // the ball can reach, passes through the balls that touch them, every step an exact drop
-  // line; the program is simulated again. Only when H was asked.
-  // A tessellated part whose clearance and deviation take half of H or more is left alone: the
-  // balls stand that far off the exact faces wherever they go, so what exceeds H there is the
-  // clearance's, which no rest pass removes (bearing.iges: 298 passes for nothing).
-  report.restFinishing =
-      height.has_value() && !options.noRestFinishing && job.clearance + job.deviation < 0.5 * *height;
-  const std::size_t rasterPasses = paths.path.passes.size();
-  for (int round = 0; report.restFinishing && round < kRestRounds; ++round) {
-    if (round > 0 ? simulated.uncutPoints == 0 : restTargets(simulated, *height).empty()) break;
-    // A second round only when the first took at least a tenth of what was above H.
-    if (round > 0 && simulated.uncutArea > 0.9 * report.restRounds.back().uncutAreaBefore) break;
-    RestOptions rest;
-    rest.toolRadius = report.toolRadius;
-    rest.scallopHeight = *height;
-    progress(fmt::format("rest finishing: {} grid points left above H", simulated.uncutPoints));
-    RestRound summary{simulated.maxScallop, simulated.uncutArea, {}};
-    RestPasses passes = meshRestPasses(*raster.solid, *raster.cutter, simulated, rest, raster.dropLine);
-    summary.rest = passes.report;
-    report.restRounds.push_back(summary);
-    if (passes.path.passes.empty()) break;
-    for (ToolPass& pass : passes.path.passes) paths.path.passes.push_back(std::move(pass));
-    simulated = writeAndSimulate();
-  }
-  if (!report.restRounds.empty()) {
-    // The deepest the ball comes, over the rest passes too (exact distances to the mesh; the
-    // raster's own least distance is already in the report).
-    GougeReport& deepest = *report.gouge;
-    double least = raster.cutter->radius() - deepest.signedMaxDepth;
-    for (std::size_t p = rasterPasses; p < paths.path.passes.size(); ++p) {
-      const ToolPass& pass = paths.path.passes[p];
-      Vec3 at = pass.start;
-      for (const ToolMove& move : pass.moves) {
-        const double d = raster.cutter->segmentDistance(at, move.end, least);
-        if (d < least) {
-          least = d;
-          deepest.deepest.center = move.end;
-        }
-        at = move.end;
-      }
-    }
-    deepest.signedMaxDepth = raster.cutter->radius() - least;
-    deepest.maxDepth = std::max(0.0, deepest.signedMaxDepth);
-    deepest.depthBound = deepest.maxDepth;
-  }
-  report.motion = gcodeMotion(paths.path, gcodeOptions, rapidRate);
-  report.feedRate = gcodeOptions.feedRate;
-  report.plungeFeedRate = gcodeOptions.plungeFeedRate;
-  report.rapidRate = rapidRate;
-  report.verification = verificationSummary(simulated, *simulation.stockAllowance);
-  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  progress("writing the report");
-  replaceDirectory(options.out,
-                   {{programName, program},
-                    {"report.json", pathsToJson(report, paths.path)},
-                    {"verify.svg", verifySvg(simulated, {path, programName, 0, 0.0})}},
-                   kPlanOutputs);
+// `plan` on a mesh (an STL mesh, or a tessellated part: `part`): the library's mesh plan
+// (mesh_plan.hpp), its files written and summed up in one line.
+void runPlanMesh(const PlanArguments& options, const Mesh& mesh, const TessellatedPart* part,
+                 const MeshPlanOptions& job) {
+  const std::string& path = job.source;
+  const MeshPlanResult planned = part != nullptr ? planMesh(*part, job, stageLines("plan", options.quiet))
+                                                 : planMesh(mesh, job, stageLines("plan", options.quiet));
+  const PathsReport& report = planned.toolpaths.report;
+  const MeshRasterPaths& paths = planned.toolpaths.raster;
+  const SimulationReport& simulated = planned.simulated;
+  const std::optional<double> height = report.scallopHeight;
+  if (!options.quiet) fmt::print(stderr, "scallop plan: writing the report...\n");
+  replaceDirectory(options.out, meshPlanFiles(planned), kPlanOutputs);
   const std::string units(unitsName(mesh.units));
   fmt::print(stderr,
              "scallop plan: raster on {}{}: {} triangles, {} lines {:.5g} to {:.5g} {} apart, tool-centre length {:.4f} {}, "
              "{} moves proven within eps {:.2g} ({} unproven), deepest ball interference {:.6f} {} (exact); {}; "
              "simulated: gouge {:.6f}, scallop max {:.6f} / 99% {:.6f} {}{}{}; {:.2f} s -> {}/\n",
              path,
-             job.tessellation
+             report.tessellation
                  ? fmt::format(" (tessellated: deviation {:.3g} {}, clearance {:.3g}; simulated on the {})",
-                               report.tessellation->deviation, unitsName(mesh.units), job.clearance,
+                               report.tessellation->deviation, unitsName(mesh.units), report.tessellation->clearance,
                                report.tessellation->exactDesign ? "exact faces" : "mesh")
                  : std::string(),
-             mesh.triangles.size(), paths.lines, paths.minSpacing, spacing, units, paths.centreLength, units,
+             mesh.triangles.size(), paths.lines, paths.minSpacing, report.spacing, units, paths.centreLength, units,
              paths.path.passes.empty() ? 0 : paths.path.passes[0].moves.size(), paths.eps, paths.unprovenMoves,
              report.gouge->maxDepth, units, cycleSummary(report, mesh.units) + restSummary(report, mesh.units),
              simulated.maxGouge, simulated.maxScallop,
@@ -276,11 +172,11 @@ void runPlan(const PlanArguments& options) {
                               "already",
                               options.surface.input));
     const StlMesh stl = loadStlMesh(options.surface.input, options.units, options.dropZeroArea);
-    MeshJob job;
+    rejectMeshOptions(options, "a mesh");
+    MeshPlanOptions job = meshPlanOptions(options);
     job.description = fmt::format("{} triangles ({})", stl.mesh.triangles.size(),
                                   stl.format == StlFormat::binary ? "binary STL" : "ASCII STL");
-    job.mesh = stl.mesh;
-    return runPlanMesh(options, std::move(job));
+    return runPlanMesh(options, stl.mesh, nullptr, job);
   }
   if (!options.units.empty() || options.dropZeroArea)
     throw Error("--units and --drop-zero-area are for STL meshes (a .stl file); a surface's units are in its file");
@@ -288,9 +184,10 @@ void runPlan(const PlanArguments& options) {
   const CadRoute route = cadRoute(options.surface, options.tessellate, options.deflection, exactRationalFaces(options.surface));
   if (route.tessellate) {
     rejectMeshOptions(options, "a tessellated part");
-    MeshJob job = tessellatedJob(*route.part, route.exact, meshRequest(options), options.deflection);
-    job.part = &*route.part;
-    return runPlanMesh(options, std::move(job));
+    announceTessellation(*route.part, route.exact, "plan", options.quiet);
+    const MeshPlanOptions job = meshPlanOptions(options);
+    const TessellatedPart part = tessellatedJob(*route.part, job, options.deflection, "plan", options.quiet);
+    return runPlanMesh(options, part.mesh, &part, job);
   }
   SurfaceSource from = options.surface;
   if (from.input.empty() && from.example.empty()) from.example = "paper-1";  // the main job
@@ -313,14 +210,7 @@ void runPlan(const PlanArguments& options) {
   job.dialect = gcodeDialect(options.dialect);
   if (!options.rapidRate.empty())
     job.rapidRate = parsePositive(options.rapidRate, "rapid rate", "a positive rate");
-  JobControl control;
-  if (!options.quiet)
-    control.progress = [last = std::string()](double, const std::string& stage) mutable {
-      if (stage == last || stage == "done") return;  // a stage's advances; the end
-      last = stage;
-      fmt::print(stderr, "scallop plan: {}...\n", stage);
-    };
-  const PlanResult planned = plan(surface, job, control);
+  const PlanResult planned = plan(surface, job, stageLines("plan", options.quiet));
   const PathsReport& report = planned.toolpaths.report;
   const OptimalSlicing& orientation = planned.orientation;
   const SimulationReport& simulated = planned.simulated;

@@ -37,6 +37,7 @@
 
 #include "cad/cad_file.hpp"
 #include "scallop/error.hpp"
+#include "scallop/job_control.hpp"
 #include "scallop/parallel.hpp"
 
 namespace scallop {
@@ -186,6 +187,7 @@ CadTessellation CadPart::tessellate(const TessellationOptions& options) const {
   std::unordered_map<VertexKey, std::uint32_t, VertexKeyHash> merged;
   std::size_t total = 0;
   for (std::size_t f = 0; f < impl_->faceList.size(); ++f) {
+    checkCancelled();  // a plan's (tessellate_part.hpp): per face of the sampling below
     const TopoDS_Face& face = impl_->faceList[f];
     TopLoc_Location location;
     const Handle(Poly_Triangulation) triangulation = BRep_Tool::Triangulation(face, location);
@@ -307,13 +309,18 @@ void CadPart::designHeights(HeightGrid& grid, std::vector<double>* normalZ, cons
   std::atomic<std::size_t> nextRow{j0};
   std::exception_ptr failure;
   std::mutex failureMutex;
+  // The caller's job control (job_control.hpp), on every thread: each line polls its cancel,
+  // each row reports progress (on the calling thread only).
+  const JobControl* const control = currentJobControl();
   const auto work = [&] {
     try {
       IntCurvesFace_ShapeIntersector intersector;
       intersector.Load(impl_->file.shape, Precision::Confusion());
       std::unordered_map<const TopoDS_TShape*, BRepAdaptor_Surface> surfaces;
       for (std::size_t j = nextRow++; j <= j1; j = nextRow++) {
+        advanceStage(j - j0, rows);
         for (std::size_t i = i0; i <= i1; ++i) {
+          checkCancelled();
           const Vec2 p = grid.point(i, j);
           intersector.Perform(gp_Lin(gp_Pnt(p.x, p.y, top), gp_Dir(0.0, 0.0, -1.0)), 0.0, length);
           if (!intersector.IsDone() || intersector.NbPnt() == 0) continue;
@@ -348,7 +355,11 @@ void CadPart::designHeights(HeightGrid& grid, std::vector<double>* normalZ, cons
     }
   };
   std::vector<std::thread> pool;
-  for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(work);
+  for (std::size_t t = 1; t < threads; ++t)
+    pool.emplace_back([&work, control] {
+      const JobControlScope scope(control, false);
+      work();
+    });
   work();
   for (std::thread& thread : pool) thread.join();
   if (failure) {

@@ -16,6 +16,7 @@
 #include <fmt/format.h>
 
 #include "scallop/error.hpp"
+#include "scallop/job_control.hpp"
 
 namespace scallop {
 namespace {
@@ -438,6 +439,7 @@ class ProgramWriter {
     }
     Point current = start;
     for (const ToolMove& move : pass.moves) {
+      if (++written_ % 1024 == 0) checkCancelled();  // a plan's cancel (job_control.hpp)
       const Point end = tipOf(move.end, radius);
       if (move.kind == MoveKind::arc) {
         writeArc(current, end, tipOf(move.center, radius), move.plane, move.clockwise);
@@ -559,6 +561,7 @@ class ProgramWriter {
   std::array<bool, 3> known_ = {false, false, false};
   std::optional<std::int64_t> feed_;
   ArcPlane plane_ = ArcPlane::xy;  // the header's G17
+  std::size_t written_ = 0;        // moves written, for the cancel's polls
 };
 
 }  // namespace

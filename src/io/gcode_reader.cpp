@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 
 #include "scallop/error.hpp"
+#include "scallop/job_control.hpp"
 #include "support/input_file.hpp"
 #include "support/text_input.hpp"
 
@@ -301,6 +302,7 @@ GcodeProgram parseGcodeProgram(std::string_view text, const std::string& sourceN
     text.remove_prefix(newline == std::string_view::npos ? text.size() : newline + 1);
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
     ++lineNumber;
+    if (lineNumber % 1024 == 0) checkCancelled();  // a plan's cancel (job_control.hpp)
     if (lineNumber > kGcodeMaxLines)
       throw Error(fmt::format("{}: more than {} lines", detail::displayName(sourceName), kGcodeMaxLines));
     if (!reader.readLine(line, lineNumber)) break;

@@ -12,6 +12,7 @@
 
 #include "scallop/error.hpp"
 #include "scallop/geometry/tolerances.hpp"
+#include "scallop/job_control.hpp"
 
 namespace scallop {
 
@@ -566,6 +567,7 @@ DropLine MeshDropCutter::dropLine(Vec2 origin, Vec2 direction, double t0, double
   DropLineVertex a = line.at(t0);
   line.push(a);
   for (std::size_t i = 1; i <= n; ++i) {
+    checkCancelled();  // a station's drops and proofs: a plan's cancel stops it here
     const double t = i == n ? t1 : t0 + (t1 - t0) * (static_cast<double>(i) / static_cast<double>(n));
     const DropLineVertex b = line.at(t);
     line.refine(a, b, 0);

@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "scallop/error.hpp"
+#include "scallop/job_control.hpp"
 
 namespace scallop {
 
@@ -23,13 +24,16 @@ Mesh meshWithSkirt(const Mesh& mesh, double offset) {
   for (const Vec3& v : mesh.vertices) bottom = std::min(bottom, v.z);
   // Each edge's uses, and the far vertex of its (last) triangle: the side of the material.
   std::map<std::pair<std::uint32_t, std::uint32_t>, std::pair<int, std::uint32_t>> uses;
-  for (const auto& t : mesh.triangles)
+  for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
+    if (f % 4096 == 0) checkCancelled();
+    const auto& t = mesh.triangles[f];
     for (std::size_t k = 0; k < 3; ++k) {
       const std::uint32_t u = t[k], v = t[(k + 1) % 3];
       auto& use = uses[{std::min(u, v), std::max(u, v)}];
       ++use.first;
       use.second = t[(k + 2) % 3];
     }
+  }
   const auto add = [&](Vec3 p) {
     out.vertices.push_back(p);
     return static_cast<std::uint32_t>(out.vertices.size() - 1);
@@ -77,6 +81,7 @@ std::vector<double> adaptiveOffsets(const Mesh& mesh, double radius, Vec2 along,
   std::vector<Vec3> normals(facets), centroids(facets);
   std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<std::size_t>> edgeFacets;
   for (std::size_t f = 0; f < facets; ++f) {
+    if (f % 4096 == 0) checkCancelled();
     const auto& t = mesh.triangles[f];
     const Vec3 a = mesh.vertices[t[0]], b = mesh.vertices[t[1]], c = mesh.vertices[t[2]];
     Vec3 n = cross(b - a, c - a);
@@ -92,7 +97,9 @@ std::vector<double> adaptiveOffsets(const Mesh& mesh, double radius, Vec2 along,
   // stands above the facet's plane, the angle between their normals over their centroids'
   // distance (a curvature estimate, in any direction: conservative across the feed).
   std::vector<double> concave(facets, 0.0);
+  std::size_t edges = 0;
   for (const auto& [edge, list] : edgeFacets) {
+    if (++edges % 4096 == 0) checkCancelled();
     for (const std::size_t f : list) {
       for (const std::size_t g : list) {
         if (f == g || normals[f].z <= 0.0 || normals[g].z <= 0.0) continue;
@@ -109,6 +116,7 @@ std::vector<double> adaptiveOffsets(const Mesh& mesh, double radius, Vec2 along,
   }
   std::vector<Band> bands;
   for (std::size_t f = 0; f < facets; ++f) {
+    if (f % 4096 == 0) checkCancelled();
     const Vec3 n = normals[f];
     if (!(n.z > 0.0)) continue;  // vertical or degenerate: touches through its edges only
     const auto& t = mesh.triangles[f];
@@ -139,6 +147,7 @@ std::vector<double> adaptiveOffsets(const Mesh& mesh, double radius, Vec2 along,
   std::vector<double> offsets{b0};
   floorSteps = 0;
   for (double at = b0; at < b1;) {
+    checkCancelled();
     double step = most;
     for (std::size_t i = bucketOf(at); i <= std::min(count - 1, bucketOf(at + most)); ++i)
       for (const std::size_t k : buckets[i])
@@ -230,7 +239,11 @@ MeshRasterPaths meshRasterPaths(const MeshDropCutter& cutter, const Mesh& mesh, 
   // Every line's drop line; those that touch nothing (beyond the mesh by R) are left out.
   std::vector<DropLine> dropLines;
   std::vector<double> kept;
-  for (const double b : offsets) {
+  // Progress (job_control.hpp): the lines take about three quarters of the work, the links
+  // the rest.
+  for (std::size_t k = 0; k < offsets.size(); ++k) {
+    advanceStage(3 * k, 4 * offsets.size());
+    const double b = offsets[k];
     DropLine line = cutter.dropLine(Vec2{b * across.x, b * across.y}, along, t0, t1, drop);
     tally(line);
     const bool touches = std::any_of(line.vertices.begin(), line.vertices.end(), [](const DropLineVertex& v) {
@@ -249,6 +262,7 @@ MeshRasterPaths meshRasterPaths(const MeshDropCutter& cutter, const Mesh& mesh, 
   out.minSpacing = lines > 2 ? std::numeric_limits<double>::infinity() : (lines == 2 ? kept[1] - kept[0] : 0.0);
   for (std::size_t k = 0; k + 2 < lines; ++k) out.minSpacing = std::min(out.minSpacing, kept[k + 1] - kept[k]);
   for (std::size_t k = 0; k < lines; ++k) {
+    advanceStage(3 * lines + k, 4 * lines);
     const bool backwards = k % 2 == 1;
     if (k > 0) {
       // The link across, at the end both lines share: from b_k-1 to b_k along e. Its first

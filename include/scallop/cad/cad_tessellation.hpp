@@ -54,7 +54,9 @@
 //         may miss both and report the surface below (a deeper design: never a false
 //         gouge), as may a line along a vertical face. The grid's points are split among
 //         `threads` threads (0: the hardware's), each with its own intersector; the result
-//         does not depend on the number of threads.
+//         does not depend on the number of threads. The caller's job control
+//         (job_control.hpp) is polled per line on every thread (scallop::Cancelled) and
+//         advanced per row on the calling thread; tessellate polls it per face.
 //         Budget: more than maxRays lines is an error naming the grid and the budget (at
 //         roughly 100-300 us per line, 1,000,000 lines is a few minutes).
 // Errors: scallop::Error, one line naming the file and, for a face, "face N" with its entity.

@@ -16,7 +16,8 @@
 //         ball's TIP = centre - (0, 0, R), R = path.toolRadius, which is what a controller
 //         with the tool length offset measured to the tip moves (the header says so).
 //         Positions, feeds and tolerances are in the path's units: G20 (inch) or G21 (mm).
-//         Time and memory O(number of moves).
+//         Time and memory O(number of moves). Polls the thread's job control
+//         (job_control.hpp) every 1024 moves: scallop::Cancelled.
 // Numbers: fixed point, never an exponent, never nan/inf, never "-0": coordinates with
 //         kGcodeDecimalsInch = 5 decimals in inch (quantum q = 0.00001 in = 0.25 um) and
 //         kGcodeDecimalsMm = 4 in mm (q = 0.0001 mm); feeds and spindle speed rounded to the

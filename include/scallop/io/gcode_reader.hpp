@@ -40,7 +40,8 @@
 //           "p.ngc:12: unsupported word 'T1': scallop verify reads only ..."
 //           "p.ngc:7: G91 (incremental distance mode) is not supported; use G90".
 //         Never crashes or loops: time and memory O(length of the text); at most
-//         kGcodeMaxLines lines and kGcodeMaxLineLength characters per line.
+//         kGcodeMaxLines lines and kGcodeMaxLineLength characters per line. Polls the
+//         thread's job control (job_control.hpp) every 1024 lines: scallop::Cancelled.
 
 #include <cstddef>
 #include <string>

@@ -86,7 +86,8 @@
 //         of range, a non-finite vertex, a non-finite query point, cutoff negative or NaN, a
 //         direction not unit and horizontal, t0 > t1 or not finite, step, eps or sag
 //         tolerance not positive, more than maxVertices output vertices.
-// Threads: every query is const; one cutter may be shared by threads.
+// Threads: every query is const; one cutter may be shared by threads. dropLine polls the
+//         thread's job control (job_control.hpp) per station: scallop::Cancelled.
 
 #include <array>
 #include <cstddef>

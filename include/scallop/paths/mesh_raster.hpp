@@ -43,6 +43,9 @@
 //         lines (the message gives the count), and dropLine's errors (budget included).
 // Cost:   sum over lines of dropLine's cost: O(vertices) drops and proofs, each O(features
 //         within about R).
+// Progress: the caller's stage (job_control.hpp) advances per line and per link; the cancel
+//         is polled there, per drop-line station and every 4096 facets of the adaptive
+//         steps' and meshWithSkirt's passes over the mesh (scallop::Cancelled).
 // Deterministic.
 
 #include <cstddef>
