@@ -24,6 +24,7 @@
 #include "scallop/paths/gouge.hpp"
 #include "scallop/geometry/mesh.hpp"
 #include "scallop/paths/mesh_drop.hpp"
+#include "scallop/paths/mesh_raster.hpp"
 #include "scallop/parallel.hpp"
 #include "scallop/geometry/surface.hpp"
 
@@ -833,8 +834,30 @@ SimulationReport simulateCut(const Mesh& mesh, const std::vector<SweptMove>& mov
   auto triangles = std::make_shared<std::vector<std::uint32_t>>();
   meshDesign(mesh, report.design, &report.designNormalZ, triangles.get());
   report.designSeconds = secondsSince(start);
+  const double radius = options.toolRadius;
+  double lowest = kInf;
+  for (const Vec3& v : mesh.vertices) lowest = std::min(lowest, v.z);
   sweepAndCompare(report, moves, options,
-                  meshReach(mesh, report.design, triangles, options.toolRadius, options.scallopHeight), start);
+                  meshReach(mesh, report.design, triangles, options.toolRadius, options.scallopHeight), start,
+                  [&]() -> std::function<ClearanceTest()> {
+                    // The mesh as the top of a solid: walls under its open edges, down to its
+                    // lowest vertex, at the edges themselves (meshWithSkirt). A centre at or
+                    // above that lowest z whose vertical segment up to R above the whole mesh
+                    // is proven R - gougeTolerance clear of the solid's boundary is outside it
+                    // (inside, or under the sheet, the segment meets the top) and its ball
+                    // reaches into a column of the z-map only across the walls (at the
+                    // centre's height, the ball's widest slice) or above the top: so it cut
+                    // no deeper than the tolerance, as on a surface (the contract).
+                    const auto cutter = std::make_shared<const MeshDropCutter>(meshWithSkirt(mesh, 0.0), radius);
+                    const double ceiling = top + radius * (1.0 + 1e-9) + 1e-9 * std::abs(top);
+                    return [cutter, clearance = radius - report.gougeTolerance, top = ceiling, lowest]() -> ClearanceTest {
+                      return [cutter, clearance, top, lowest](Vec3 c) {
+                        if (c.z >= top) return true;
+                        if (!(clearance > 0.0) || c.z < lowest) return false;
+                        return cutter->segmentClear(c, {c.x, c.y, top}, clearance);
+                      };
+                    };
+                  });
   return report;
 }
 

@@ -25,6 +25,7 @@
 #include "scallop/paths/gouge.hpp"
 #include "scallop/slicing/optimal_slicing.hpp"
 #include "scallop/paths/raster.hpp"
+#include "scallop/geometry/mesh.hpp"
 #include "scallop/geometry/surface.hpp"
 #include "scallop/io/verify_output.hpp"
 #include "support/rational_patches.hpp"
@@ -679,6 +680,72 @@ TEST(CutSimulation, AVerticalWallGrazedByTheBallIsNoGougeButACutIntoItIs) {
   // The wall's column away from the pass into it stays cleared.
   EXPECT_GT(cut.clearedGougePoints, 40u);
   EXPECT_LT(cut.clearedGougePoints, wallPoints);
+}
+
+// The same step as a mesh of six triangles, open at its rim (mesh_raster.hpp's skirt walls
+// it for the proofs): the grazing ball's wall column is cleared as on the surface (all 129
+// points, by a proof against the mesh as the top of a solid); the pass into the wall and the
+// ball buried under the top are gouges, each under its own ball; a ball whose centre is
+// below the mesh's lowest vertex is never cleared. Off, the raw vertical measure counts the wall.
+TEST(CutSimulationMesh, AVerticalWallGrazedByTheBallIsNoGougeButACutIntoItIs) {
+  Mesh step;
+  step.units = Units::inch;
+  step.vertices = {{-1.0, 0.0, 1.0}, {-1.0, 2.0, 1.0}, {0.0, 0.0, 1.0}, {0.0, 2.0, 1.0},
+                   {0.0, 0.0, 0.0},  {0.0, 2.0, 0.0},  {1.0, 0.0, 0.0}, {1.0, 2.0, 0.0}};
+  step.triangles = {{0, 2, 3}, {0, 3, 1}, {2, 4, 5}, {2, 5, 3}, {4, 6, 7}, {4, 7, 5}};
+  const double radius = 0.25, depth = 0.05;
+  const SimulationOptions options = gougeOnlyOptions(radius, 1.0 / 64.0);
+  const SweptMove grazing = lineMove({radius, -0.5, radius}, {radius, 2.5, radius});
+  const SimulationReport grazed = simulateCut(step, {grazing}, options);
+  std::size_t wallPoints = 0;
+  for (std::size_t j = 0; j < grazed.design.rows; ++j)
+    for (std::size_t i = 0; i < grazed.design.columns; ++i) {
+      const std::size_t k = j * grazed.design.columns + i;
+      const bool deep = grazed.design.z[k] - grazed.stock.z[k] > grazed.gougeTolerance;
+      if (!deep) continue;
+      EXPECT_EQ(grazed.design.point(i, j).x, 0.0);
+      EXPECT_NE(grazed.clearedGouge[k], 0);
+      ++wallPoints;
+    }
+  EXPECT_EQ(wallPoints, 129u);  // y = 0, 1/64, ..., 2
+  EXPECT_EQ(grazed.clearedGougePoints, wallPoints);
+  EXPECT_NEAR(grazed.maxClearedGouge, 1.0 - radius, 1e-12);
+  EXPECT_EQ(grazed.gougePoints, 0u);
+
+  SimulationOptions unchecked = options;
+  unchecked.clearVerticalGouges = false;
+  const SimulationReport raw = simulateCut(step, {grazing}, unchecked);
+  EXPECT_EQ(raw.gougePoints, wallPoints);
+  EXPECT_EQ(raw.clearedGougePoints, 0u);
+
+  const SweptMove into = lineMove({radius - depth, 0.5, radius}, {radius - depth, 1.5, radius});
+  const SweptMove buried = lineMove({-0.5, 1.0, 0.3}, {-0.5, 1.2, 0.3});
+  const SimulationReport cut = simulateCut(step, {grazing, into, buried}, options);
+  EXPECT_GT(cut.maxGouge, depth);
+  std::size_t nearInto = 0, nearBuried = 0;
+  for (std::size_t j = 0; j < cut.design.rows; ++j)
+    for (std::size_t i = 0; i < cut.design.columns; ++i) {
+      const std::size_t k = j * cut.design.columns + i;
+      const Vec2 p = cut.design.point(i, j);
+      if (cut.design.z[k] - cut.stock.z[k] <= cut.gougeTolerance || cut.clearedGouge[k]) continue;
+      const bool byInto = std::abs(p.x - (radius - depth)) <= radius && p.y >= 0.5 - radius && p.y <= 1.5 + radius;
+      const bool byBuried = std::abs(p.x + 0.5) <= radius && p.y >= 1.0 - radius && p.y <= 1.2 + radius;
+      EXPECT_TRUE(byInto || byBuried) << p.x << ", " << p.y;
+      nearInto += byInto;
+      nearBuried += byBuried;
+    }
+  EXPECT_GT(nearInto, 100u);
+  EXPECT_GT(nearBuried, 100u);
+  EXPECT_EQ(cut.gougePoints, nearInto + nearBuried);
+  EXPECT_GT(cut.clearedGougePoints, 40u);
+
+  // Below the mesh's lowest vertex (z = 0): a ball R beside the floor's edge (its equator on
+  // the edge's column, R from every triangle) is not cleared, and one nearer than R is a gouge.
+  const SweptMove under = lineMove({1.0 + radius, 0.5, -0.1}, {1.0 + radius, 1.5, -0.1});
+  const SweptMove reaching = lineMove({1.0 + 0.5 * radius, 0.5, -0.5 * radius}, {1.0 + 0.5 * radius, 1.5, -0.5 * radius});
+  const SimulationReport low = simulateCut(step, {under, reaching}, options);
+  EXPECT_GT(low.gougePoints, 0u);
+  EXPECT_EQ(low.clearedGougePoints, 0u);
 }
 
 // A steep plane, z = 2 y over x in [0, 2], y in [0, 1], cut as a raster pass down its slope

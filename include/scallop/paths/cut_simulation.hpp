@@ -109,7 +109,14 @@
 //         edge), so a drop envelope found from a nearby contact would refuse a ball the
 //         direct proof clears.
 //         Arcs, and points past maxClearanceChecks, are not cleared (they count as gouges).
-//         Meshes and designs from elsewhere are not checked (their routes keep a clearance).
+//         On a Mesh the same proof runs against the mesh as the top of a solid (meshWithSkirt:
+//         walls under its open edges, down to its lowest vertex, at the edges themselves), for
+//         centres at or above that lowest z: such a ball reaches into a grid point's column
+//         only across the walls (its widest slice, at its centre's height, meets them first)
+//         or from above the top, both proven R - gougeTolerance away. (OCCT's shape.stl,
+//         plan's defaults: 1.695 mm of such "gouges" beside its walls, 0.0024 mm once
+//         cleared, against a tolerance of 0.0025 mm.) Designs from elsewhere (a part's exact
+//         faces through a callback) are not checked.
 // Meshes: a triangle mesh (mesh.hpp) may stand for the surface: the grid covers its
 //         vertices' xy box; the design at a grid point is the highest of the triangles over
 //         it, exactly (barycentric coordinates in the xy projection, each >= -1e-12 so that a
@@ -212,7 +219,7 @@ struct SimulationOptions {
   /// Budget: reach checks (one closest point and one drop-cutter height each); past it the
   /// remaining points count as reachable (in the scallop figures), and the report says so.
   std::size_t maxReachChecks = 400'000;
-  /// Clear vertical gouges on a Surface by the drop envelope at the centre that cut them
+  /// Clear vertical gouges on a Surface or a Mesh by a proof at the centre that cut them
   /// lowest (see the contract's Vertical walls); false: every one counts.
   bool clearVerticalGouges = true;
   /// Budget of those checks (one segment-clearance proof each); past it the rest count as gouges.
