@@ -101,10 +101,10 @@ void rejectMeshOptions(const PlanArguments& options, const char* what) {
   reject(options.noLinking || options.oneWay, "--no-linking/--one-way", "order a surface plan's passes (a mesh's raster is one zigzag)");
 }
 
-// What plan asks of a mesh plan, parsed (the strings' errors name the option).
-MeshPlanOptions meshPlanOptions(const PlanArguments& options) {
-  MeshPlanOptions job;
-  job.source = sourceName(options.surface);  // "<stdin>" for "-"
+// The ball and the step between passes, as both plans take them (a spacing, or else H; unset
+// ones keep the job's defaults). The strings' errors name the option.
+template <typename Job>
+void parseToolAndStep(const PlanArguments& options, Job& job) {
   if (!options.toolRadius.empty())
     job.toolRadius = parsePositive(options.toolRadius, "tool radius", "a positive length");
   if (!options.spacing.empty()) {
@@ -112,6 +112,13 @@ MeshPlanOptions meshPlanOptions(const PlanArguments& options) {
   } else if (!options.scallopHeight.empty()) {
     job.scallopHeight = parsePositive(options.scallopHeight, "scallop height", "a positive length");
   }
+}
+
+// What plan asks of a mesh plan, parsed (the strings' errors name the option).
+MeshPlanOptions meshPlanOptions(const PlanArguments& options) {
+  MeshPlanOptions job;
+  job.source = sourceName(options.surface);  // "<stdin>" for "-"
+  parseToolAndStep(options, job);
   job.restFinishing = !options.noRestFinishing;
   job.dialect = gcodeDialect(options.dialect);
   if (!options.rapidRate.empty()) job.rapidRate = parsePositive(options.rapidRate, "rapid rate", "a positive rate");
@@ -195,13 +202,7 @@ void runPlan(const PlanArguments& options) {
   scallop::PlanOptions job;
   job.source = sourceName(from);
   job.strategy = parseStrategy(options.strategy.empty() ? "contour" : options.strategy);
-  if (!options.toolRadius.empty())
-    job.toolRadius = parsePositive(options.toolRadius, "tool radius", "a positive length");
-  if (!options.spacing.empty()) {
-    job.spacing = parsePositive(options.spacing, "spacing", "a positive length");
-  } else if (!options.scallopHeight.empty()) {
-    job.scallopHeight = parsePositive(options.scallopHeight, "scallop height", "a positive length");
-  }
+  parseToolAndStep(options, job);
   job.link = !options.noLinking;
   job.dropEnvelope = !options.noDropEnvelope;
   job.constantSpacing = options.constantSpacing;

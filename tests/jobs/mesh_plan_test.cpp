@@ -23,6 +23,7 @@
 
 #include <fmt/format.h>
 
+#include "support/cancel_moments.hpp"
 #include "support/cli_fixture.hpp"
 #include "support/mesh_fixtures.hpp"
 #include "support/message_checks.hpp"
@@ -344,34 +345,9 @@ TEST(MeshPlan, ACancelFromAnotherThreadAtAnyMomentStopsItSoon) {
   }
   // Cancels spread over the whole run, from a second thread, while the plan runs on every core.
   constexpr int kMoments = 6;
-  double worst = 0.0;
-  double ranOn = 0.0;  // the longest a run went on after a cancel it did not throw for
-  int cancelled = 0;
-  for (int k = 0; k < kMoments; ++k) {
-    const double delay = whole * (k + 0.5) / kMoments;
-    JobControl control;
-    std::optional<Clock::time_point> stopped;
-    bool threwCancelled = false;
-    std::thread job([&] {
-      try {
-        planMesh(mesh, spacedPlan(), control);
-      } catch (const Cancelled&) {
-        threwCancelled = true;
-      }
-      stopped = Clock::now();
-    });
-    std::this_thread::sleep_for(std::chrono::duration<double>(delay));
-    const Clock::time_point asked = Clock::now();
-    control.cancel.cancel();
-    job.join();
-    ASSERT_TRUE(stopped.has_value());
-    if (threwCancelled) {
-      ++cancelled;
-      worst = std::max(worst, std::chrono::duration<double>(*stopped - asked).count());
-    } else if (*stopped > asked) {
-      ranOn = std::max(ranOn, std::chrono::duration<double>(*stopped - asked).count());
-    }
-  }
+  const scallop::test::CancelFigures figures = scallop::test::cancelAtSpreadMoments(
+      kMoments, whole, [&](const JobControl& control) { planMesh(mesh, spacedPlan(), control); });
+  const auto [cancelled, worst, ranOn] = figures;
   // Runs vary with the machine's load, so a later run may end before its cancel; most cancels
   // still come while it runs, and each of those stops it.
   EXPECT_GE(cancelled, kMoments / 2);

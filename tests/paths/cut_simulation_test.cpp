@@ -13,6 +13,7 @@
 #include <numbers>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "support/mesh_fixtures.hpp"
@@ -604,6 +605,26 @@ SimulationOptions gougeOnlyOptions(double radius, double resolution) {
   return options;
 }
 
+// The wall tests' gouges left after clearing, each under the ball that interferes (within R
+// of its centre line): the pass into the wall at x = R - depth, y in [0.5, 1.5], or the ball
+// buried at x = -0.5, y in [1, 1.2]. Counted per ball; a gouge under neither fails.
+std::pair<std::size_t, std::size_t> gougesUnderTheWallTestsBalls(const SimulationReport& cut, double radius,
+                                                                 double depth) {
+  std::size_t nearInto = 0, nearBuried = 0;
+  for (std::size_t j = 0; j < cut.design.rows; ++j)
+    for (std::size_t i = 0; i < cut.design.columns; ++i) {
+      const std::size_t k = j * cut.design.columns + i;
+      const Vec2 p = cut.design.point(i, j);
+      if (cut.design.z[k] - cut.stock.z[k] <= cut.gougeTolerance || cut.clearedGouge[k]) continue;
+      const bool byInto = std::abs(p.x - (radius - depth)) <= radius && p.y >= 0.5 - radius && p.y <= 1.5 + radius;
+      const bool byBuried = std::abs(p.x + 0.5) <= radius && p.y >= 1.0 - radius && p.y <= 1.2 + radius;
+      EXPECT_TRUE(byInto || byBuried) << p.x << ", " << p.y;
+      nearInto += byInto;
+      nearBuried += byBuried;
+    }
+  return {nearInto, nearBuried};
+}
+
 // Vertical walls (the contract): a ball running along the floor tangent to the wall lowers
 // the wall's grid column to its centre, a vertical "gouge" of the wall's height where the
 // ball cut nothing (its distance to the step, in closed form below, is R); those points are
@@ -661,19 +682,7 @@ TEST(CutSimulation, AVerticalWallGrazedByTheBallIsNoGougeButACutIntoItIs) {
   EXPECT_GT(stepDistance(buried.start), radius);  // clear of every face, but inside the part
   const SimulationReport cut = simulateCut(step, {grazing, into, buried}, options);
   EXPECT_GT(cut.maxGouge, depth);
-  std::size_t nearInto = 0, nearBuried = 0;
-  for (std::size_t j = 0; j < cut.design.rows; ++j)
-    for (std::size_t i = 0; i < cut.design.columns; ++i) {
-      const std::size_t k = j * cut.design.columns + i;
-      const Vec2 p = cut.design.point(i, j);
-      if (cut.design.z[k] - cut.stock.z[k] <= cut.gougeTolerance || cut.clearedGouge[k]) continue;
-      // Every gouge is under the ball that interferes (within R of its centre line).
-      const bool byInto = std::abs(p.x - (radius - depth)) <= radius && p.y >= 0.5 - radius && p.y <= 1.5 + radius;
-      const bool byBuried = std::abs(p.x + 0.5) <= radius && p.y >= 1.0 - radius && p.y <= 1.2 + radius;
-      EXPECT_TRUE(byInto || byBuried) << p.x << ", " << p.y;
-      nearInto += byInto;
-      nearBuried += byBuried;
-    }
+  const auto [nearInto, nearBuried] = gougesUnderTheWallTestsBalls(cut, radius, depth);
   EXPECT_GT(nearInto, 100u);
   EXPECT_GT(nearBuried, 100u);
   EXPECT_EQ(cut.gougePoints, nearInto + nearBuried);  // the two regions do not overlap
@@ -722,18 +731,7 @@ TEST(CutSimulationMesh, AVerticalWallGrazedByTheBallIsNoGougeButACutIntoItIs) {
   const SweptMove buried = lineMove({-0.5, 1.0, 0.3}, {-0.5, 1.2, 0.3});
   const SimulationReport cut = simulateCut(step, {grazing, into, buried}, options);
   EXPECT_GT(cut.maxGouge, depth);
-  std::size_t nearInto = 0, nearBuried = 0;
-  for (std::size_t j = 0; j < cut.design.rows; ++j)
-    for (std::size_t i = 0; i < cut.design.columns; ++i) {
-      const std::size_t k = j * cut.design.columns + i;
-      const Vec2 p = cut.design.point(i, j);
-      if (cut.design.z[k] - cut.stock.z[k] <= cut.gougeTolerance || cut.clearedGouge[k]) continue;
-      const bool byInto = std::abs(p.x - (radius - depth)) <= radius && p.y >= 0.5 - radius && p.y <= 1.5 + radius;
-      const bool byBuried = std::abs(p.x + 0.5) <= radius && p.y >= 1.0 - radius && p.y <= 1.2 + radius;
-      EXPECT_TRUE(byInto || byBuried) << p.x << ", " << p.y;
-      nearInto += byInto;
-      nearBuried += byBuried;
-    }
+  const auto [nearInto, nearBuried] = gougesUnderTheWallTestsBalls(cut, radius, depth);
   EXPECT_GT(nearInto, 100u);
   EXPECT_GT(nearBuried, 100u);
   EXPECT_EQ(cut.gougePoints, nearInto + nearBuried);
