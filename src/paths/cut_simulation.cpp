@@ -828,15 +828,16 @@ SimulationReport simulateCut(const Surface& surface, const std::vector<SweptMove
 
 SimulationReport simulateCut(const Mesh& mesh, const std::vector<SweptMove>& moves, const SimulationOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  double top = -kInf;
-  for (const Vec3& v : mesh.vertices) top = std::max(top, v.z);
+  double top = -kInf, lowest = kInf;
+  for (const Vec3& v : mesh.vertices) {
+    top = std::max(top, v.z);
+    lowest = std::min(lowest, v.z);
+  }
   SimulationReport report = reportFor(mesh.units, simulationGrid(mesh, options), top, options);
   auto triangles = std::make_shared<std::vector<std::uint32_t>>();
   meshDesign(mesh, report.design, &report.designNormalZ, triangles.get());
   report.designSeconds = secondsSince(start);
   const double radius = options.toolRadius;
-  double lowest = kInf;
-  for (const Vec3& v : mesh.vertices) lowest = std::min(lowest, v.z);
   sweepAndCompare(report, moves, options,
                   meshReach(mesh, report.design, triangles, options.toolRadius, options.scallopHeight), start,
                   [&]() -> std::function<ClearanceTest()> {
@@ -849,8 +850,8 @@ SimulationReport simulateCut(const Mesh& mesh, const std::vector<SweptMove>& mov
                     // centre's height, the ball's widest slice) or above the top: so it cut
                     // no deeper than the tolerance, as on a surface (the contract).
                     const auto cutter = std::make_shared<const MeshDropCutter>(meshWithSkirt(mesh, 0.0), radius);
-                    const double ceiling = top + radius * (1.0 + 1e-9) + 1e-9 * std::abs(top);
-                    return [cutter, clearance = radius - report.gougeTolerance, top = ceiling, lowest]() -> ClearanceTest {
+                    return [cutter, clearance = radius - report.gougeTolerance, top = ballTopAbove(top, radius),
+                            lowest]() -> ClearanceTest {
                       return [cutter, clearance, top, lowest](Vec3 c) {
                         if (c.z >= top) return true;
                         if (!(clearance > 0.0) || c.z < lowest) return false;

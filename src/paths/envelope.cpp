@@ -18,10 +18,11 @@ namespace scallop {
 
 // Above every control point by R: every surface point is at least R below a ball centre
 // there, so at least R away. A relative hair more for the rounding of the comparison.
-double ballTop(const Surface& surface, double radius) {
-  const double top = controlPointTop(surface);
-  return top + radius * (1.0 + 1e-9) + 1e-9 * std::abs(top);
+double ballTopAbove(double highest, double radius) {
+  return highest + radius * (1.0 + 1e-9) + 1e-9 * std::abs(highest);
 }
+
+double ballTop(const Surface& surface, double radius) { return ballTopAbove(controlPointTop(surface), radius); }
 
 namespace {
 

@@ -140,6 +140,8 @@ ToolPath liftToDropEnvelope(const SurfaceDistance& distance, const ToolPath& pat
 /// The height above which a ball centre of radius R is clear of the whole surface: R (and a
 /// relative hair for rounding) above its highest control point (convex hull property).
 double ballTop(const Surface& surface, double radius);
+/// The same above any geometry whose highest point is `highest` (a mesh's highest vertex).
+double ballTopAbove(double highest, double radius);
 
 /// Drop-cutter heights: the drop envelope Z(x, y) at points one after another, each lifted
 /// from below the whole surface as liftToDropEnvelope lifts a vertex (the lowest height found
