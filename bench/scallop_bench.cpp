@@ -6,6 +6,12 @@
 //   BM_BruteForceEnvelope/<n>  the envelope sampled at the n vertex abscissae by taking the
 //                              maximum over every vertex arc and edge offset: O(n^2), as a
 //                              sampling approach without the hull's ordering would
+// and two floors under the scallop hull that the upper hull does not have:
+//   BM_HullOutputCopy/<n>      a copy of scallopHull's result on the same chain (its hull
+//                              and tool-path vectors): fresh memory written with the same
+//                              bytes, what returning that output costs any algorithm
+//   BM_EdgeNormals/<n>         the unit upward normal of every edge (a square root and two
+//                              divisions each), which the offset lines need
 
 #include <benchmark/benchmark.h>
 
@@ -60,6 +66,36 @@ void BM_UpperHull(benchmark::State& state) {
   for (auto _ : state) {
     std::vector<std::size_t> hull = scallop::upperHullIndices(chain);
     benchmark::DoNotOptimize(hull.data());
+  }
+  state.SetItemsProcessed(state.iterations() * state.range(0));
+}
+
+void BM_HullOutputCopy(benchmark::State& state) {
+  const Chain& chain = randomWalk(static_cast<std::size_t>(state.range(0)));
+  const scallop::ScallopHull result = scallop::scallopHull(chain, kRadius);
+  for (auto _ : state) {
+    scallop::ScallopHull copy = result;
+    benchmark::DoNotOptimize(copy.toolpath.data());
+    benchmark::DoNotOptimize(copy.hull.data());
+  }
+  state.counters["elements"] = static_cast<double>(result.hull.size() + result.toolpath.size());
+  state.counters["MB"] = static_cast<double>(result.hull.size() * sizeof(scallop::HullElement) +
+                                             result.toolpath.size() * sizeof(scallop::PathElement)) /
+                         1e6;
+  state.SetItemsProcessed(state.iterations() * state.range(0));
+}
+
+void BM_EdgeNormals(benchmark::State& state) {
+  const Chain& chain = randomWalk(static_cast<std::size_t>(state.range(0)));
+  for (auto _ : state) {
+    double sum = 0.0;
+    for (std::size_t i = 0; i + 1 < chain.size(); ++i) {
+      const double dx = chain[i + 1].x - chain[i].x;
+      const double dz = chain[i + 1].z - chain[i].z;
+      const double length = std::sqrt(dx * dx + dz * dz);
+      sum += -dz / length + dx / length;
+    }
+    benchmark::DoNotOptimize(sum);
   }
   state.SetItemsProcessed(state.iterations() * state.range(0));
 }
@@ -313,6 +349,8 @@ BENCHMARK(BM_MedialAxis)->Arg(1000)->Arg(10000)->Arg(100000)->Unit(benchmark::kM
 
 BENCHMARK(BM_ScallopHull)->RangeMultiplier(2)->Range(1 << 10, 1 << 23)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_UpperHull)->RangeMultiplier(2)->Range(1 << 10, 1 << 23)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_HullOutputCopy)->Arg(1 << 10)->Arg(1 << 14)->Arg(1 << 20)->Arg(1 << 23)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_EdgeNormals)->Arg(1 << 10)->Arg(1 << 14)->Arg(1 << 20)->Arg(1 << 23)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_BruteForceEnvelope)->RangeMultiplier(4)->Range(1 << 10, 1 << 14)->Unit(benchmark::kMillisecond);
 
 BENCHMARK_MAIN();
