@@ -12,6 +12,9 @@
 //                              bytes, what returning that output costs any algorithm
 //   BM_EdgeNormals/<n>         the unit upward normal of every edge (a square root and two
 //                              divisions each), which the offset lines need
+// and a prototype of a leaner stack pass (bench/unit_stack_pass.hpp; the envelope only, no
+// hull or tool path), checked against the library's tool path before it is timed:
+//   BM_UnitStackPass/<n>
 
 #include <benchmark/benchmark.h>
 
@@ -25,6 +28,7 @@
 #include "scallop/slicing/optimal_slicing.hpp"
 #include "scallop/paths/scallop_hull.hpp"
 #include "scallop/geometry/surface.hpp"
+#include "unit_stack_pass.hpp"
 
 namespace {
 
@@ -97,6 +101,36 @@ void BM_EdgeNormals(benchmark::State& state) {
     }
     benchmark::DoNotOptimize(sum);
   }
+  state.SetItemsProcessed(state.iterations() * state.range(0));
+}
+
+void BM_UnitStackPass(benchmark::State& state) {
+  const Chain& chain = randomWalk(static_cast<std::size_t>(state.range(0)));
+  const double scale = scallop::coordinateScale(chain);
+  scallop_bench::UnitStackPass pass(kRadius, scale);
+  // Checked first: the envelope it stacks is the library's tool path, at 4,096 abscissae.
+  const scallop::ScallopHull reference = scallop::scallopHull(chain, kRadius);
+  if (!pass.run(chain)) {
+    state.SkipWithError("the unit pass met a case it leaves to the library");
+    return;
+  }
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> abscissa(chain.front().x - kRadius, chain.back().x + kRadius);
+  double worst = 0.0;
+  for (int i = 0; i < 4096; ++i) {
+    const double x = abscissa(rng);
+    worst = std::max(worst, std::abs(pass.height(x) - scallop::pathHeightAt(reference.toolpath, x)));
+  }
+  if (!(worst <= 1e-9 * (scale + kRadius))) {
+    state.SkipWithError("the unit pass's envelope differs from the library's tool path");
+    return;
+  }
+  for (auto _ : state) {
+    const bool ok = pass.run(chain);
+    benchmark::DoNotOptimize(ok);
+  }
+  state.counters["worst_gap"] = worst;
+  state.counters["undecided"] = static_cast<double>(pass.undecided());
   state.SetItemsProcessed(state.iterations() * state.range(0));
 }
 
@@ -351,6 +385,7 @@ BENCHMARK(BM_ScallopHull)->RangeMultiplier(2)->Range(1 << 10, 1 << 23)->Unit(ben
 BENCHMARK(BM_UpperHull)->RangeMultiplier(2)->Range(1 << 10, 1 << 23)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_HullOutputCopy)->Arg(1 << 10)->Arg(1 << 14)->Arg(1 << 20)->Arg(1 << 23)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_EdgeNormals)->Arg(1 << 10)->Arg(1 << 14)->Arg(1 << 20)->Arg(1 << 23)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_UnitStackPass)->Arg(1 << 10)->Arg(1 << 14)->Arg(1 << 20)->Arg(1 << 23)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_BruteForceEnvelope)->RangeMultiplier(4)->Range(1 << 10, 1 << 14)->Unit(benchmark::kMillisecond);
 
 BENCHMARK_MAIN();
