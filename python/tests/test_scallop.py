@@ -609,10 +609,9 @@ class MeshTest(unittest.TestCase):
             with self.assertRaisesRegex(scallop.Error, re.escape(truncated) + ".*truncated"):
                 scallop.load_stl(truncated)
             # Three points on a line: refused, and the keyword that skips it named.
-            line = "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex {} 0 0\nvertex {} 0 0\nendloop\nendfacet\n"
-            flat = ("solid s\n" + line.format(1, 2)).replace("endfacet\n", "endfacet\n", 1)
-            good = "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n"
-            zero = write_file(folder, "zero.stl", (flat + good + "endsolid s\n").encode())
+            facet = "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex {}\nvertex {}\nendloop\nendfacet\n"
+            text = "solid s\n" + facet.format("1 0 0", "2 0 0") + facet.format("1 0 0", "0 1 0") + "endsolid s\n"
+            zero = write_file(folder, "zero.stl", text.encode())
             with self.assertRaisesRegex(scallop.Error, re.escape(zero) + ".*zero area.*drop_zero_area=True"):
                 scallop.load_stl(zero)
             read = scallop.load_stl(zero, units="in", drop_zero_area=True)
@@ -667,6 +666,25 @@ class MeshPlanCliTest(unittest.TestCase):
         self.assertEqual(gcode_problems(plan.program), [])
         self.assertIn("G21", plan.program)  # mm
         self.assertEqual(len(plan.passes), len(report["passes"]))
+
+    def test_mesh_paths_are_the_bytes_of_scallop_paths(self):
+        # The raster alone, as `scallop paths shape.stl --json --gcode` writes it; and the same
+        # from the mesh's own numpy arrays, named as the file.
+        with tempfile.TemporaryDirectory() as folder:
+            json_path, gcode_path = os.path.join(folder, "paths.json"), os.path.join(folder, "paths.ngc")
+            subprocess.run([scallop_cli(), "paths", SHAPE_STL, *self.ARGUMENTS, "--json", json_path,
+                            "--gcode", gcode_path], check=True, capture_output=True)
+            with open(json_path, "rb") as file:
+                cli_json = file.read()
+            with open(gcode_path, "rb") as file:
+                cli_gcode = file.read()
+        paths = scallop.mesh_paths(self.stl, tool_radius=6, scallop_height=0.2)
+        self.assertEqual(paths.report_json.encode(), cli_json)
+        self.assertEqual(paths.gcode().encode(), cli_gcode)
+        arrays = scallop.Mesh(self.stl.mesh.vertices, self.stl.mesh.triangles, units="mm")
+        again = scallop.mesh_paths(arrays, tool_radius=6, scallop_height=0.2, source=SHAPE_STL)
+        self.assertEqual(again.report_json, paths.report_json)
+        self.assertEqual(again.lines, self.plan.lines)  # the plan's raster, before its rest passes
 
     def test_cancel_from_the_progress_callback(self):
         token = scallop.CancelToken()
