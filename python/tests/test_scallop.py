@@ -629,7 +629,8 @@ class MeshTest(unittest.TestCase):
 class MeshPlanCliTest(unittest.TestCase):
     """plan_mesh on OCCT's shape.stl against `scallop plan shape.stl`, byte for byte."""
 
-    ARGUMENTS = ["--tool-radius", "6", "--scallop-height", "0.2"]  # mm; about 1.5 s each
+    R, H = 6.0, 0.3  # mm: about 1 s a plan
+    ARGUMENTS = ["--tool-radius", "6", "--scallop-height", "0.3"]
 
     @classmethod
     def setUpClass(cls):
@@ -637,7 +638,7 @@ class MeshPlanCliTest(unittest.TestCase):
             cls.cli_files, cls.cli_stages = cli_plan([SHAPE_STL, *cls.ARGUMENTS], folder)
         cls.progress = []
         cls.stl = scallop.load_stl(SHAPE_STL)
-        cls.plan = scallop.plan_mesh(cls.stl, tool_radius=6, scallop_height=0.2,
+        cls.plan = scallop.plan_mesh(cls.stl, tool_radius=cls.R, scallop_height=cls.H,
                                      progress=lambda fraction, stage: cls.progress.append((fraction, stage)))
 
     def test_the_files_are_the_cli_bytes(self):
@@ -657,11 +658,12 @@ class MeshPlanCliTest(unittest.TestCase):
         plan = self.plan
         report = json.loads(plan.report_json)
         self.assertEqual(report["source"], SHAPE_STL)
-        self.assertEqual((plan.strategy, plan.units, plan.tool_radius, plan.scallop_height), ("raster", "mm", 6.0, 0.2))
+        self.assertEqual((plan.strategy, plan.units, plan.tool_radius, plan.scallop_height),
+                         ("raster", "mm", self.R, self.H))
         self.assertEqual(report["verification"]["max_gouge"], plan.max_gouge)
         self.assertEqual(plan.unproven_moves, 0)
         self.assertLess(plan.max_gouge, 0.01)
-        self.assertLessEqual(plan.max_scallop, 0.2)
+        self.assertLessEqual(plan.max_scallop, self.H)
         self.assertEqual(plan.program_name, "toolpath.ngc")
         self.assertEqual(gcode_problems(plan.program), [])
         self.assertIn("G21", plan.program)  # mm
@@ -678,11 +680,11 @@ class MeshPlanCliTest(unittest.TestCase):
                 cli_json = file.read()
             with open(gcode_path, "rb") as file:
                 cli_gcode = file.read()
-        paths = scallop.mesh_paths(self.stl, tool_radius=6, scallop_height=0.2)
+        paths = scallop.mesh_paths(self.stl, tool_radius=self.R, scallop_height=self.H)
         self.assertEqual(paths.report_json.encode(), cli_json)
         self.assertEqual(paths.gcode().encode(), cli_gcode)
         arrays = scallop.Mesh(self.stl.mesh.vertices, self.stl.mesh.triangles, units="mm")
-        again = scallop.mesh_paths(arrays, tool_radius=6, scallop_height=0.2, source=SHAPE_STL)
+        again = scallop.mesh_paths(arrays, tool_radius=self.R, scallop_height=self.H, source=SHAPE_STL)
         self.assertEqual(again.report_json, paths.report_json)
         self.assertEqual(again.lines, self.plan.lines)  # the plan's raster, before its rest passes
 
@@ -697,13 +699,13 @@ class MeshPlanCliTest(unittest.TestCase):
                 token.cancel()
 
         with self.assertRaises(scallop.Cancelled) as caught:
-            scallop.plan_mesh(self.stl, tool_radius=6, scallop_height=0.2, progress=progress, cancel=token)
+            scallop.plan_mesh(self.stl, tool_radius=self.R, scallop_height=self.H, progress=progress, cancel=token)
         self.assertIsInstance(caught.exception, scallop.Error)
         self.assertTrue(token.cancelled)
         self.assertNotIn("done", after)
         # Cancelled before it starts: the raster alone too.
         with self.assertRaises(scallop.Cancelled):
-            scallop.mesh_paths(self.stl, tool_radius=6, scallop_height=0.2, cancel=token)
+            scallop.mesh_paths(self.stl, tool_radius=self.R, scallop_height=self.H, cancel=token)
 
 
 @unittest.skipUnless(scallop.has_cad and os.path.exists(SCREW_STEP) and scallop_cli(),
