@@ -46,6 +46,7 @@ TessellatedPart tessellatedJob(const CadPart& part, const MeshPlanOptions& plan,
   options.toolRadius = plan.toolRadius;
   options.scallopHeight = plan.scallopHeight;
   options.spacing = plan.spacing;
+  options.deflectionOption = "--deflection";  // the warning names the flag
   TessellatedPart tessellated = tessellatePart(part, options, stageLines(command, quiet));
   if (!quiet)
     for (const std::string& warning : tessellated.warnings)

@@ -1,7 +1,9 @@
 // The Python module `scallop`: a thin pybind11 layer over the library's front doors (plan.hpp,
-// toolpath_job.hpp, optimal_slicing.hpp, scallop_hull.hpp, cut_simulation.hpp). Point sets
-// cross as numpy float64 arrays (N x 2 or N x 3), everything else as plain numbers, strings
-// and the library's JSON text; no core type is subclassed.
+// toolpath_job.hpp, mesh_plan.hpp, optimal_slicing.hpp, scallop_hull.hpp, cut_simulation.hpp,
+// mesh.hpp's STL reader and, when scallop::cad is built (SCALLOP_PYTHON_CAD), the STEP and
+// IGES parts of cad_tessellation.hpp and tessellate_part.hpp). Point sets cross as numpy
+// float64 arrays (N x 2 or N x 3), a mesh's triangles as an (M, 3) uint32 array, everything
+// else as plain numbers, strings and the library's JSON text; no core type is subclassed.
 //
 // Contract of the binding
 // -----------------------
@@ -9,13 +11,14 @@
 //   scallop.Cancelled (a scallop.Error); arrays of the wrong shape or choices outside their
 //   enumeration as ValueError; wrong types as TypeError. Nothing the caller passes crashes
 //   the interpreter: every input reaches the library's own validation first.
-// Threads: the long calls (plan, paths, orient, verify, hull, load_surface) release the GIL,
+// Threads: the long calls (plan, paths, plan_mesh, mesh_paths, tessellate_part, orient,
+//   verify, hull, and the readers load_surface, load_stl, CadPart) release the GIL,
 //   so another Python thread may run meanwhile, e.g. to call CancelToken.cancel(). The
 //   progress callback runs on the calling thread with the GIL held (job_control.hpp: never
 //   on a worker); an exception it raises unwinds the job and comes out of the call as that
-//   same exception. Ctrl-C (KeyboardInterrupt) is checked at every progress report (plan and
-//   paths); orient and verify take a CancelToken (no progress); hull and the readers run to
-//   their end (linear in their input).
+//   same exception. Ctrl-C (KeyboardInterrupt) is checked at every progress report (plan,
+//   paths, plan_mesh, mesh_paths, tessellate_part); orient and verify take a CancelToken (no
+//   progress); hull and the readers run to their end (linear in their input).
 // Units: every length is in the surface's units ("in" or "mm"); angles are named *_deg or
 //   *_rad.
 
@@ -23,8 +26,10 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <array>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <memory>
 #include <numbers>
@@ -33,6 +38,13 @@
 #include <utility>
 #include <vector>
 
+#ifdef SCALLOP_PYTHON_CAD
+#include "scallop/cad/cad_import.hpp"
+#include "scallop/cad/cad_tessellation.hpp"
+#include "scallop/cad/tessellate_part.hpp"
+#endif
+#include "scallop/geometry/mesh.hpp"
+#include "scallop/jobs/mesh_plan.hpp"
 #include "scallop/paths/chain.hpp"
 #include "scallop/io/chain_io.hpp"
 #include "scallop/paths/cut_simulation.hpp"
@@ -48,6 +60,7 @@
 #include "scallop/io/paths_output.hpp"
 #include "scallop/jobs/plan.hpp"
 #include "scallop/paths/scallop_hull.hpp"
+#include "scallop/paths/tessellated_part.hpp"
 #include "scallop/geometry/surface.hpp"
 #include "scallop/io/surface_io.hpp"
 #include "scallop/paths/toolpath.hpp"
@@ -292,6 +305,36 @@ struct Verification {
   scallop::VerifySources sources;
 };
 
+// An STL file as read: the mesh, and how the CLI names it (its path; "<n> triangles (binary
+// STL)" in the plan's first stage).
+struct StlFile {
+  scallop::StlMesh stl;
+  std::string path;
+};
+
+#ifdef SCALLOP_PYTHON_CAD
+// A STEP or IGES part's tessellation. Its judge (exactHeights) calls the CadPart it was made
+// from: tessellate_part keeps that Python object alive as long as this one (keep_alive).
+struct Tessellated {
+  scallop::TessellatedPart part;
+  std::string path;  // the part's file, the plans' default source
+};
+#endif
+
+struct MeshPaths {
+  scallop::MeshToolpathResult result;
+};
+
+struct MeshPlan {
+  scallop::MeshPlanResult result;
+};
+
+// What the tool-path figures read of a mesh's result: its path and its report.
+struct PathView {
+  const scallop::ToolPath& path;
+  const scallop::PathsReport& report;
+};
+
 // The passes as (k + 1, 3) arrays: the start and every move's end.
 py::list passPoints(const scallop::ToolPath& path) {
   py::list passes;
@@ -365,7 +408,8 @@ py::dict passMoves(const scallop::ToolPath& path, std::size_t index) {
   return out;
 }
 
-// The tool-path figures shared by Paths and Plan; `get` gives the ToolpathResult.
+// The tool-path figures shared by Paths, Plan, MeshPaths and MeshPlan; `get` gives what has
+// the path and its report (a ToolpathResult, a PathView).
 template <class Holder, class Get>
 void defPathFigures(py::class_<Holder>& cls, Get get) {
   cls.def_property_readonly(
@@ -607,6 +651,181 @@ Verification runVerify(const scallop::Surface& surface, const std::string& progr
   return out;
 }
 
+
+// ---- meshes -------------------------------------------------------------------------------
+
+// A Mesh from an (n, 3) array of vertices and an (m, 3) array of vertex indices. The indices'
+// range against the vertices, finiteness and the rest are the plans' checks (mesh_plan.hpp);
+// here only what uint32 cannot hold.
+scallop::Mesh makeMesh(const py::object& verticesObject, const py::object& trianglesObject, const std::string& units) {
+  scallop::Mesh mesh;
+  mesh.units = parseUnits(units);
+  const DoubleArray vertices = toDoubleArray(verticesObject, "vertices");
+  if (vertices.ndim() != 2 || vertices.shape(1) != 3)
+    throw py::value_error("vertices: expected an array of shape (n, 3), got shape " + shapeText(vertices));
+  const auto v = vertices.unchecked<2>();
+  for (py::ssize_t i = 0; i < vertices.shape(0); ++i) mesh.vertices.push_back({v(i, 0), v(i, 1), v(i, 2)});
+  using IndexArray = py::array_t<long long, py::array::c_style | py::array::forcecast>;
+  const py::array asArray = py::array::ensure(trianglesObject);
+  if (!asArray || (asArray.size() > 0 && asArray.dtype().kind() != 'i' && asArray.dtype().kind() != 'u'))
+    throw py::type_error("triangles: expected an array of integers (vertex indices), got " +
+                         (asArray ? "an array of dtype " + std::string(py::str(asArray.dtype()))
+                                  : std::string(py::str(trianglesObject.get_type()))));
+  const IndexArray triangles = IndexArray::ensure(asArray);
+  if (!triangles || triangles.ndim() != 2 || triangles.shape(1) != 3)
+    throw py::value_error("triangles: expected an array of shape (m, 3), got shape " + shapeText(asArray));
+  const auto t = triangles.unchecked<2>();
+  for (py::ssize_t i = 0; i < triangles.shape(0); ++i) {
+    std::array<std::uint32_t, 3> triangle{};
+    for (py::ssize_t k = 0; k < 3; ++k) {
+      const long long index = t(i, k);
+      if (index < 0 || index > static_cast<long long>(std::numeric_limits<std::uint32_t>::max()))
+        throw py::value_error("triangles[" + std::to_string(i) + "]: vertex index " + std::to_string(index) +
+                              " is negative or too large");
+      triangle[static_cast<std::size_t>(k)] = static_cast<std::uint32_t>(index);
+    }
+    mesh.triangles.push_back(triangle);
+  }
+  return mesh;
+}
+
+// As `scallop plan PART.stl` names the mesh in its first stage.
+std::string stlDescription(const scallop::StlMesh& stl) {
+  return std::to_string(stl.mesh.triangles.size()) +
+         (stl.format == scallop::StlFormat::binary ? " triangles (binary STL)" : " triangles (ASCII STL)");
+}
+
+StlFile loadStl(const std::string& path, const std::string& units, bool dropZeroArea) {
+  scallop::StlOptions options;
+  options.units = parseUnits(units);
+  options.dropZeroArea = dropZeroArea;
+  StlFile out;
+  out.path = path;
+  const py::gil_scoped_release release;
+  try {
+    out.stl = scallop::readStl(path, options);
+  } catch (const scallop::Error& e) {
+    // As the CLI adds its flag (apps/surface_options.cpp), the keyword that skips them.
+    if (!dropZeroArea && std::string(e.what()).find("zero area") != std::string::npos)
+      throw scallop::Error(std::string(e.what()) + "; drop_zero_area=True skips such triangles");
+    throw;
+  }
+  return out;
+}
+
+// What a mesh plan takes: a Mesh, an StlMesh or a TessellatedPart, with the CLI's names.
+struct MeshInput {
+  const scallop::Mesh* mesh = nullptr;
+  const scallop::TessellatedPart* part = nullptr;  // instead of mesh
+  std::string source = "mesh";
+  std::string description;
+};
+
+MeshInput meshInput(const py::object& object) {
+  MeshInput in;
+  if (py::isinstance<scallop::Mesh>(object)) {
+    in.mesh = &object.cast<const scallop::Mesh&>();
+  } else if (py::isinstance<StlFile>(object)) {
+    const StlFile& file = object.cast<const StlFile&>();
+    in.mesh = &file.stl.mesh;
+    in.source = file.path;
+    in.description = stlDescription(file.stl);
+#ifdef SCALLOP_PYTHON_CAD
+  } else if (py::isinstance<Tessellated>(object)) {
+    const Tessellated& tessellated = object.cast<const Tessellated&>();
+    in.part = &tessellated.part;
+    in.source = tessellated.path;
+#endif
+  } else {
+    throw py::type_error("mesh: expected a scallop.Mesh, StlMesh or TessellatedPart, got " +
+                         std::string(py::str(object.get_type())));
+  }
+  return in;
+}
+
+scallop::MeshPlanOptions meshPlanOptions(const MeshInput& in, std::optional<double> toolRadius,
+                                         std::optional<double> scallopHeight, std::optional<double> spacing,
+                                         const std::optional<std::string>& source,
+                                         const std::optional<std::string>& description) {
+  scallop::MeshPlanOptions options;
+  options.source = source.value_or(in.source);
+  options.description = description.value_or(in.description);
+  options.toolRadius = toolRadius;
+  options.scallopHeight = scallopHeight;
+  options.spacing = spacing;
+  return options;
+}
+
+MeshPaths runMeshPaths(const py::object& meshObject, std::optional<double> toolRadius,
+                       std::optional<double> scallopHeight, std::optional<double> spacing,
+                       std::optional<double> rapidRate, const std::optional<std::string>& source,
+                       const std::optional<std::string>& description, const py::object& progress,
+                       const std::optional<scallop::CancelToken>& cancel) {
+  const MeshInput in = meshInput(meshObject);
+  const scallop::MeshPlanOptions options = meshPlanOptions(in, toolRadius, scallopHeight, spacing, source, description);
+  const scallop::Units units = in.part != nullptr ? in.part->mesh.units : in.mesh->units;
+  const double rate = rapidRate.value_or(scallop::defaultRapidRate(units));
+  if (!(rate > 0.0) || !std::isfinite(rate)) throw scallop::Error("the rapid rate must be positive");
+  const PythonJobControl job(progress, cancel);
+  MeshPaths out;
+  {
+    const py::gil_scoped_release release;
+    out.result = in.part != nullptr ? scallop::meshToolpaths(*in.part, options, job.control())
+                                    : scallop::meshToolpaths(*in.mesh, options, job.control());
+    // As `scallop paths PART.stl`: the program's motion at the default feeds, in the report.
+    scallop::MeshToolpathResult& r = out.result;
+    const scallop::GcodeOptions gcode =
+        scallop::defaultGcodeOptions(units, r.partTop, r.raster.path, scallop::GcodeDialect::linuxcnc,
+                                     "scallop paths raster " + options.source);
+    r.report.motion = scallop::gcodeMotion(r.raster.path, gcode, rate);
+    r.report.feedRate = gcode.feedRate;
+    r.report.plungeFeedRate = gcode.plungeFeedRate;
+    r.report.rapidRate = rate;
+  }
+  return out;
+}
+
+MeshPlan runMeshPlan(const py::object& meshObject, std::optional<double> toolRadius,
+                     std::optional<double> scallopHeight, std::optional<double> spacing, const std::string& dialect,
+                     bool restFinishing, std::optional<double> rapidRate, const std::optional<std::string>& source,
+                     const std::optional<std::string>& description, const py::object& progress,
+                     const std::optional<scallop::CancelToken>& cancel) {
+  const MeshInput in = meshInput(meshObject);
+  scallop::MeshPlanOptions options = meshPlanOptions(in, toolRadius, scallopHeight, spacing, source, description);
+  options.restFinishing = restFinishing;
+  options.dialect = parseDialect(dialect);
+  options.rapidRate = rapidRate;
+  const PythonJobControl job(progress, cancel);
+  MeshPlan out;
+  {
+    const py::gil_scoped_release release;
+    out.result = in.part != nullptr ? scallop::planMesh(*in.part, options, job.control())
+                                    : scallop::planMesh(*in.mesh, options, job.control());
+  }
+  return out;
+}
+
+// The figures of a mesh's raster shared by MeshPaths and MeshPlan; `get` gives the
+// MeshToolpathResult.
+template <class Holder, class Get>
+void defMeshRasterFigures(py::class_<Holder>& cls, Get get) {
+  cls.def_property_readonly(
+         "lines", [get](const Holder& h) { return get(h).raster.lines; }, "Raster lines (along x).")
+      .def_property_readonly(
+          "min_spacing", [get](const Holder& h) { return get(h).raster.minSpacing; },
+          "The least step between lines but the last (0 with one line); spacing is the largest.")
+      .def_property_readonly(
+          "drops", [get](const Holder& h) { return get(h).raster.drops; }, "Exact drops of the ball computed.")
+      .def_property_readonly(
+          "unproven_moves", [get](const Holder& h) { return get(h).raster.unprovenMoves; },
+          "Moves of the raster not proven clear of the mesh within eps (0 unless a budget ran out).")
+      .def_property_readonly(
+          "eps", [get](const Holder& h) { return get(h).raster.eps; },
+          "The proofs' tolerance eps (1e-6 of the mesh's size).")
+      .def_property_readonly(
+          "part_top", [get](const Holder& h) { return get(h).partTop; },
+          "The mesh's highest vertex (the G-code's safe height stands above it).");
+}
 }  // namespace
 
 PYBIND11_MODULE(scallop, m) {
@@ -614,7 +833,8 @@ PYBIND11_MODULE(scallop, m) {
       "scallop: exact tool paths for 3-axis ball-end milling (scallop hull, optimal slicing), a thin layer "
       "over the C++ library. Lengths are in the surface's units; point sets are numpy float64 arrays.\n\n"
       "Front doors: plan (the whole job: tool path, G-code, simulated cut), paths, orient, hull, verify; "
-      "surfaces from Surface(control_points), load_surface, example_surface.";
+      "surfaces from Surface(control_points), load_surface, example_surface. Meshes: plan_mesh, mesh_paths on a "
+      "Mesh(vertices, triangles), load_stl, or (has_cad) tessellate_part(CadPart(path)) for STEP and IGES.";
   m.attr("__version__") = SCALLOP_VERSION;
 
   // Cancelled is registered after Error: pybind11 tries the latest translator first, so a
@@ -625,8 +845,9 @@ PYBIND11_MODULE(scallop, m) {
   cancelled.attr("__doc__") = "The job was cancelled through its CancelToken.";
 
   py::class_<scallop::CancelToken>(m, "CancelToken",
-                                   "A shared cancellation flag: give it to plan or paths, call cancel() from any "
-                                   "thread (or from the progress callback); the job then raises scallop.Cancelled.")
+                                   "A shared cancellation flag: give it to plan, paths, plan_mesh, mesh_paths or "
+                                   "tessellate_part, call cancel() from any thread (or from the progress callback); "
+                                   "the job then raises scallop.Cancelled.")
       .def(py::init<>())
       .def("cancel", &scallop::CancelToken::cancel, "Asks the job to stop; thread-safe, idempotent.")
       .def_property_readonly("cancelled", &scallop::CancelToken::cancelled, "True once cancel() was called.");
@@ -986,6 +1207,254 @@ PYBIND11_MODULE(scallop, m) {
         "with a ball of radius tool_radius on a z-map of the stock, and compares it with the surface: gouges "
         "(vertical), scallops (along the normal), area left above H (default 0.001 in / 0.025 mm), as "
         "`scallop verify`. scallop.Error names the program's line for what it cannot read. cancel: a CancelToken (scallop.Cancelled).");
+
+  // ---- meshes: STL files, STEP and IGES parts through their tessellation, the mesh plan
+  py::class_<scallop::Mesh>(
+      m, "Mesh",
+      "An indexed triangle mesh (mesh.hpp): vertices, triangles as three vertex indices each, one unit of "
+      "length. The triangles' vertex order gives their normal, (b - a) x (c - a).")
+      .def(py::init(&makeMesh), py::arg("vertices"), py::arg("triangles"), py::arg("units") = "mm",
+           "Mesh(vertices, triangles, units='mm'): vertices an (n, 3) array of coordinates, triangles an (m, 3) "
+           "array of vertex indices from 0; units 'mm' or 'in' ('inch'). The plans check the rest (indices in "
+           "range, finite coordinates, at least one triangle) and raise scallop.Error.")
+      .def_property_readonly(
+          "units", [](const scallop::Mesh& mesh) { return std::string(scallop::unitsName(mesh.units)); },
+          "\"in\" or \"mm\".")
+      .def_property_readonly(
+          "vertices",
+          [](const scallop::Mesh& mesh) {
+            py::array_t<double> out = matrix(mesh.vertices.size(), 3);
+            auto o = out.mutable_unchecked<2>();
+            for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
+              const auto r = static_cast<py::ssize_t>(i);
+              o(r, 0) = mesh.vertices[i].x;
+              o(r, 1) = mesh.vertices[i].y;
+              o(r, 2) = mesh.vertices[i].z;
+            }
+            return out;
+          },
+          "The vertices, an (n, 3) array (a copy).")
+      .def_property_readonly(
+          "triangles",
+          [](const scallop::Mesh& mesh) {
+            py::array_t<std::uint32_t> out({static_cast<py::ssize_t>(mesh.triangles.size()), py::ssize_t{3}});
+            auto o = out.mutable_unchecked<2>();
+            for (std::size_t i = 0; i < mesh.triangles.size(); ++i)
+              for (std::size_t k = 0; k < 3; ++k)
+                o(static_cast<py::ssize_t>(i), static_cast<py::ssize_t>(k)) = mesh.triangles[i][k];
+            return out;
+          },
+          "The triangles, an (m, 3) uint32 array of vertex indices (a copy).")
+      .def("__repr__", [](const scallop::Mesh& mesh) {
+        return "<scallop.Mesh: " + std::to_string(mesh.triangles.size()) + " triangles, " +
+               std::to_string(mesh.vertices.size()) + " vertices, units " +
+               std::string(scallop::unitsName(mesh.units)) + ">";
+      });
+
+  py::class_<StlFile>(m, "StlMesh", "An STL file as read by load_stl: its mesh and what the file held.")
+      .def_property_readonly(
+          "mesh", [](const StlFile& f) -> const scallop::Mesh& { return f.stl.mesh; },
+          py::return_value_policy::reference_internal, "The mesh (equal vertices merged, file order kept).")
+      .def_readonly("path", &StlFile::path, "The file, as given: the plans' default source.")
+      .def_property_readonly(
+          "format",
+          [](const StlFile& f) { return f.stl.format == scallop::StlFormat::binary ? "binary" : "ascii"; },
+          "\"binary\" or \"ascii\".")
+      .def_property_readonly(
+          "triangles_read", [](const StlFile& f) { return f.stl.trianglesRead; }, "Triangles in the file.")
+      .def_property_readonly(
+          "zero_area_dropped", [](const StlFile& f) { return f.stl.zeroAreaDropped; },
+          "Triangles of zero area skipped (drop_zero_area=True).")
+      .def_property_readonly(
+          "description", [](const StlFile& f) { return stlDescription(f.stl); },
+          "How the plan's first stage names it, as `scallop plan` does: \"<m> triangles (binary STL)\".")
+      .def("__repr__", [](const StlFile& f) {
+        return "<scallop.StlMesh: " + f.path + ", " + stlDescription(f.stl) + ">";
+      });
+
+  m.def("load_stl", &loadStl, py::arg("path"), py::arg("units") = "mm", py::arg("drop_zero_area") = false,
+        "Reads an STL file, binary or ASCII (told apart by its size, 84 + 50 n bytes, whatever its header says), "
+        "into an indexed mesh (mesh.hpp's readStl). STL has no units: units 'mm' (default) or 'in'. The file's "
+        "facet normals are ignored. scallop.Error names the file and what is wrong: empty, too short, "
+        "truncated, a bad keyword or number (ASCII line), a coordinate not finite, a triangle of zero area "
+        "(unless drop_zero_area: skipped and counted), no triangle.");
+
+#ifdef SCALLOP_PYTHON_CAD
+  m.attr("has_cad") = true;
+  py::class_<scallop::CadPart>(
+      m, "CadPart",
+      "A STEP or IGES part whole, as OpenCASCADE models it (cad_tessellation.hpp): every face, trimmed or not. "
+      "tessellate_part makes it ready for plan_mesh; its exact faces then judge the plan's simulated cut.")
+      .def(py::init([](const std::string& path) {
+             const py::gil_scoped_release release;
+             return std::make_unique<scallop::CadPart>(path);
+           }),
+           py::arg("path"),
+           "CadPart(path): reads a STEP (.step, .stp) or IGES (.iges, .igs) file, its format by the extension or "
+           "the first line. Units: inches when the file says inches, else millimetres (OCCT converts the rest). "
+           "scallop.Error names the file for one that cannot be opened, is empty, truncated, unparsable or "
+           "holds no face.")
+      .def_property_readonly("path", &scallop::CadPart::path, "The file, as given: the plans' default source.")
+      .def_property_readonly(
+          "format", [](const scallop::CadPart& part) { return std::string(scallop::cadFormatName(part.format())); },
+          "\"STEP\" or \"IGES\".")
+      .def_property_readonly(
+          "units", [](const scallop::CadPart& part) { return std::string(scallop::unitsName(part.units())); },
+          "\"in\" or \"mm\": every length of the part and of its plans.")
+      .def_property_readonly("file_unit", &scallop::CadPart::fileUnit,
+                             "The unit as the file names it (\"INCH\", \"MM\").")
+      .def_property_readonly("faces", &scallop::CadPart::faces, "Its faces, every one tessellated.")
+      .def_property_readonly(
+          "box_low", [](const scallop::CadPart& part) { return vec3Array(part.boxLow()); },
+          "The bounding box's lowest corner (OCCT's, without tolerances).")
+      .def_property_readonly(
+          "box_high", [](const scallop::CadPart& part) { return vec3Array(part.boxHigh()); },
+          "The bounding box's highest corner.")
+      .def("__repr__", [](const scallop::CadPart& part) {
+        return "<scallop.CadPart: " + part.path() + ", " + std::string(scallop::cadFormatName(part.format())) + ", " +
+               std::to_string(part.faces()) + " faces, units " + std::string(scallop::unitsName(part.units())) + ">";
+      });
+
+  py::class_<Tessellated>(
+      m, "TessellatedPart",
+      "A part's tessellation made ready for plan_mesh (tessellated_part.hpp): the mesh, how far the exact faces "
+      "stand from it, the clearance the proofs add to R, and the exact faces as the simulated cut's judge. It "
+      "keeps its CadPart alive.")
+      .def_property_readonly(
+          "mesh", [](const Tessellated& t) -> const scallop::Mesh& { return t.part.mesh; },
+          py::return_value_policy::reference_internal, "The tessellation (the part's units).")
+      .def_readonly("path", &Tessellated::path, "The part's file: the plans' default source.")
+      .def_property_readonly(
+          "description", [](const Tessellated& t) { return t.part.description; },
+          "How the plan's first stage names the mesh (\"8302 triangles from 10 faces (STEP), ...\").")
+      .def_property_readonly(
+          "faces", [](const Tessellated& t) { return t.part.faces; }, "The part's faces, all tessellated.")
+      .def_property_readonly(
+          "deflection", [](const Tessellated& t) { return t.part.deflection; },
+          "The mesher's linear deflection D, as asked.")
+      .def_property_readonly(
+          "deviation", [](const Tessellated& t) { return t.part.deviation; },
+          "The largest distance found from the exact faces to their triangles (sampled: a measure, not a bound).")
+      .def_property_readonly(
+          "deviation_face", [](const Tessellated& t) { return t.part.deviationFace; },
+          "The face where it occurs (numbered as the importer numbers them).")
+      .def_property_readonly(
+          "deviation_at", [](const Tessellated& t) { return vec3Array(t.part.deviationAt); },
+          "And the exact face's point there.")
+      .def_property_readonly(
+          "clearance", [](const Tessellated& t) { return t.part.clearance; },
+          "c = 1.5 x deviation, added to R in every proof against the mesh.")
+      .def_property_readonly(
+          "warnings", [](const Tessellated& t) { return t.part.warnings; },
+          "What the caller should be told before the plan, one line each: e.g. that the clearance leaves more "
+          "than 3/4 of H and the scallops may exceed it.")
+      .def("__repr__", [](const Tessellated& t) { return "<scallop.TessellatedPart: " + t.part.description + ">"; });
+
+  m.def(
+      "tessellate_part",
+      [](const scallop::CadPart& part, std::optional<double> deflection, std::optional<double> toolRadius,
+         std::optional<double> scallopHeight, std::optional<double> spacing, const py::object& progress,
+         const std::optional<scallop::CancelToken>& cancel) {
+        scallop::PartMeshOptions options;
+        options.deflection = deflection;
+        options.toolRadius = toolRadius;
+        options.scallopHeight = scallopHeight;
+        options.spacing = spacing;
+        options.deflectionOption = "deflection";  // the warnings name this keyword
+        const PythonJobControl job(progress, cancel);
+        Tessellated out;
+        out.path = part.path();
+        const py::gil_scoped_release release;
+        out.part = scallop::tessellatePart(part, options, job.control());
+        return out;
+      },
+      py::arg("part"), py::kw_only(), py::arg("deflection") = py::none(), py::arg("tool_radius") = py::none(),
+      py::arg("scallop_height") = py::none(), py::arg("spacing") = py::none(), py::arg("progress") = py::none(),
+      py::arg("cancel") = py::none(), py::keep_alive<0, 1>(),
+      "A STEP or IGES part made ready for plan_mesh (tessellate_part.hpp), as `scallop plan` cuts a part whose "
+      "faces cannot be machined exactly yet: OCCT's mesh of every face with linear deflection D (default H / "
+      "8), the exact faces' deviation from it sampled, the clearance 1.5 x deviation, and the exact faces as "
+      "the judge. tool_radius, scallop_height or spacing: the plan's, as plan_mesh will take them (they set "
+      "the default D; defaults 0.25 in / 6 mm and 0.001 in / 0.025 mm by the part's units). warnings: one "
+      "when clearance + deviation exceed 3/4 of H. progress and cancel as for plan (OCCT's mesher itself runs "
+      "to its end). The result keeps the part alive.");
+#else
+  m.attr("has_cad") = false;
+#endif
+
+  py::class_<MeshPaths> meshPaths(m, "MeshPaths",
+                                  "The raster of a mesh, as `scallop paths PART.stl` makes it (mesh_plan.hpp's "
+                                  "meshToolpaths).");
+  defPathFigures(meshPaths,
+                 [](const MeshPaths& p) { return PathView{p.result.raster.path, p.result.report}; });
+  defMeshRasterFigures(meshPaths, [](const MeshPaths& p) -> const scallop::MeshToolpathResult& { return p.result; });
+  meshPaths.def(
+      "gcode",
+      [](const MeshPaths& p, const std::string& dialect) {
+        const scallop::MeshToolpathResult& r = p.result;
+        const scallop::GcodeOptions options =
+            scallop::defaultGcodeOptions(r.report.units, r.partTop, r.raster.path, parseDialect(dialect),
+                                         "scallop paths raster " + r.report.source);
+        return scallop::gcodeProgram(r.raster.path, options);
+      },
+      py::arg("dialect") = "linuxcnc",
+      "The G-code program `scallop paths PART.stl --gcode` writes (gcode.hpp): the default feeds, a safe height "
+      "above the mesh and the path; 'linuxcnc' or 'grbl'. Positions are the ball's tip.");
+
+  m.def("mesh_paths", &runMeshPaths, py::arg("mesh"), py::arg("tool_radius") = py::none(),
+        py::arg("scallop_height") = py::none(), py::arg("spacing") = py::none(), py::kw_only(),
+        py::arg("rapid_rate") = py::none(), py::arg("source") = py::none(), py::arg("description") = py::none(),
+        py::arg("progress") = py::none(), py::arg("cancel") = py::none(),
+        "The raster of a mesh (mesh_plan.hpp's meshToolpaths), as `scallop paths PART.stl`: lines along x, each "
+        "the exact drop line of the ball, every move proven clear of the mesh within eps (1e-6 of its size), at "
+        "most `spacing` apart or spaced for the scallop height H (0 < H < R) on the facets' slopes. mesh: a "
+        "Mesh, an StlMesh (load_stl) or a TessellatedPart (tessellate_part: the proofs keep its clearance). "
+        "source: the name in the report and the G-code title (default the file's path, or 'mesh'); "
+        "description: the first stage's name for the mesh. Defaults suit the units: a 0.25 in (6 mm) ball, "
+        "H = 0.001 in (0.025 mm). progress and cancel as for plan.");
+
+  py::class_<MeshPlan> meshPlan(m, "MeshPlan",
+                                "The whole plan of a mesh (mesh_plan.hpp's planMesh): raster, G-code program, "
+                                "simulated cut, rest passes.");
+  defPathFigures(meshPlan,
+                 [](const MeshPlan& p) { return PathView{p.result.toolpaths.raster.path, p.result.toolpaths.report}; });
+  defMeshRasterFigures(meshPlan,
+                       [](const MeshPlan& p) -> const scallop::MeshToolpathResult& { return p.result.toolpaths; });
+  defSimulationFigures(meshPlan,
+                       [](const MeshPlan& p) -> const scallop::SimulationReport& { return p.result.simulated; });
+  meshPlan
+      .def_property_readonly(
+          "program", [](const MeshPlan& p) { return p.result.program; }, "The G-code program.")
+      .def_property_readonly(
+          "program_name", [](const MeshPlan& p) { return p.result.programName; },
+          "toolpath.ngc (LinuxCNC) or toolpath.gcode (grbl).")
+      .def_property_readonly(
+          "rest_rounds", [](const MeshPlan& p) { return p.result.toolpaths.report.restRounds.size(); },
+          "Rounds of rest passes added where the simulated cut left more than H.")
+      .def(
+          "files",
+          [](const MeshPlan& p) {
+            py::dict out;
+            for (const scallop::OutputFile& file : scallop::meshPlanFiles(p.result))
+              out[py::str(file.path)] = py::str(file.content);
+            return out;
+          },
+          "The files `scallop plan PART.stl` writes, name -> contents: the G-code, report.json, verify.svg. "
+          "Nothing is written to disk.");
+
+  m.def("plan_mesh", &runMeshPlan, py::arg("mesh"), py::arg("tool_radius") = py::none(),
+        py::arg("scallop_height") = py::none(), py::arg("spacing") = py::none(), py::arg("dialect") = "linuxcnc",
+        py::kw_only(), py::arg("rest_finishing") = true, py::arg("rapid_rate") = py::none(),
+        py::arg("source") = py::none(), py::arg("description") = py::none(), py::arg("progress") = py::none(),
+        py::arg("cancel") = py::none(),
+        "The main job on a mesh, as `scallop plan PART.stl` (mesh_plan.hpp's planMesh): mesh_paths' raster, the "
+        "G-code program, its cut simulated (on the mesh, or on a TessellatedPart's exact faces), and with H "
+        "(not a spacing) rest passes where it leaves more than H. mesh: a Mesh, an StlMesh or a "
+        "TessellatedPart; source and description as for mesh_paths; the same options give the bytes the CLI "
+        "writes (files()). Errors: scallop.Error naming the source (no triangle, an index out of range, a "
+        "vertex not finite, R against the mesh's size, H not below R, a spacing and H both). progress: None or "
+        "a callable (fraction, stage), on this thread, never decreasing, ending at 1; cancel: a CancelToken "
+        "(scallop.Cancelled). The GIL is released meanwhile; the result is the same for every thread count.");
 
   m.def("set_thread_count", &scallop::setThreadCount, py::arg("threads"),
         "Sets the thread count of every parallel part (0: every core). Results do not depend on it.");

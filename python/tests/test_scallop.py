@@ -4,7 +4,9 @@ Every expected value is derived here, independently of the program: closed forms
 tool path is 2 + pi/2 long), exact geometry (a ball over a flat square stands R above it, and
 sqrt(R^2 - d^2) at a distance d beyond its edge), invariance under rigid motions and scaling,
 and a G-code grammar written here. The plans run on paper-1 with a coarse scallop height
-(0.01 in), so the whole file takes some ten seconds.
+(0.01 in), so the whole file takes some ten seconds. The mesh plans are checked against the
+command-line program (SCALLOP_CLI, which ctest sets) byte for byte, on OCCT's own sample parts
+(Debian's occt-misc): shape.stl, and screw.step through its tessellation.
 
     PYTHONPATH=<build>/python python3 -m unittest discover -s python/tests -v
 """
@@ -13,6 +15,7 @@ import json
 import math
 import os
 import re
+import subprocess
 import tempfile
 import threading
 import time
@@ -463,6 +466,305 @@ class CancelTest(unittest.TestCase):
                 scallop.plan(self.surface)
         finally:
             timer.cancel()
+
+
+# OCCT's sample parts (Debian's occt-misc), as the C++ tests read them.
+OCCT_SAMPLES = "/usr/share/opencascade/data"
+SHAPE_STL = os.path.join(OCCT_SAMPLES, "stl", "shape.stl")  # 494 triangles, ASCII, mm
+SCREW_STEP = os.path.join(OCCT_SAMPLES, "step", "screw.step")  # 10 faces, 8 trimmed, mm
+
+
+def scallop_cli():
+    """The command-line program: SCALLOP_CLI (ctest), else the build tree's beside the module."""
+    cli = os.environ.get("SCALLOP_CLI") or os.path.join(os.path.dirname(scallop.__file__), os.pardir, "scallop")
+    return cli if os.access(cli, os.X_OK) else None
+
+
+def cli_plan(arguments, folder):
+    """Runs `scallop plan ARGUMENTS --out FOLDER/out`: the files it wrote (name -> bytes) and
+    the stages it printed on stderr ("scallop plan: <stage>...")."""
+    out = os.path.join(folder, "out")
+    run = subprocess.run([scallop_cli(), "plan", *arguments, "--out", out], capture_output=True, text=True,
+                         check=False)
+    if run.returncode != 0:
+        raise AssertionError(f"scallop plan {' '.join(arguments)}: exit {run.returncode}: {run.stderr}")
+    files = {}
+    for name in sorted(os.listdir(out)):
+        with open(os.path.join(out, name), "rb") as file:
+            files[name] = file.read()
+    stages = [line[len("scallop plan: "):-len("...")] for line in run.stderr.splitlines()
+              if line.startswith("scallop plan: ") and line.endswith("...")]
+    return files, stages
+
+
+def stages_of(progress):
+    """The stages of (fraction, stage) reports as the CLI prints them: each new one once, not "done"."""
+    stages = []
+    for _, stage in progress:
+        if stage != "done" and (not stages or stages[-1] != stage):
+            stages.append(stage)
+    return stages
+
+
+def assert_progress(test, progress):
+    fractions = [fraction for fraction, _ in progress]
+    test.assertGreater(len(fractions), 2)
+    test.assertTrue(all(0.0 <= f <= 1.0 for f in fractions))
+    test.assertTrue(all(a <= b for a, b in zip(fractions, fractions[1:])), "progress went back")
+    test.assertEqual(progress[-1], (1.0, "done"))
+
+
+def write_file(folder, name, contents):
+    path = os.path.join(folder, name)
+    with open(path, "wb") as file:
+        file.write(contents)
+    return path
+
+
+class MeshTest(unittest.TestCase):
+    R = 0.1
+
+    # The unit square [0, 1]^2 in z = 0 as two triangles, normals up.
+    SQUARE_VERTICES = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]]
+    SQUARE_TRIANGLES = [[0, 1, 2], [0, 2, 3]]
+
+    def square(self):
+        return scallop.Mesh(self.SQUARE_VERTICES, self.SQUARE_TRIANGLES, units="in")
+
+    def test_round_trip_through_numpy(self):
+        mesh = self.square()
+        self.assertEqual(mesh.units, "in")
+        np.testing.assert_array_equal(mesh.vertices, self.SQUARE_VERTICES)
+        self.assertEqual(mesh.triangles.dtype, np.uint32)
+        np.testing.assert_array_equal(mesh.triangles, self.SQUARE_TRIANGLES)
+        self.assertIn("2 triangles", repr(mesh))
+
+    def test_raster_over_a_flat_square_stands_R_above_it(self):
+        # Over the square a dropped ball's centre is R above it, and off it the raster runs R
+        # above the lowest point seen from above (z = 0): every centre at z = R, every line
+        # at most the spacing apart, the ball never inside the square.
+        paths = scallop.mesh_paths(self.square(), tool_radius=self.R, spacing=0.1)
+        self.assertEqual((paths.strategy, paths.units, paths.tool_radius, paths.spacing), ("raster", "in", self.R, 0.1))
+        self.assertEqual(paths.unproven_moves, 0)
+        points = np.vstack(paths.passes)
+        self.assertTrue(np.all(np.abs(points[:, 2] - self.R) <= paths.eps), points[:, 2].min())
+        # The lines (along x: constant y, the links between them a few points each) cover the
+        # square and more, at most 0.1 apart, each from (at least) R before it to R beyond it.
+        ys, counts = np.unique(np.round(points[:, 1], 9), return_counts=True)
+        lines = ys[counts > 4]
+        self.assertEqual(paths.lines, len(lines))
+        self.assertLessEqual(lines.min(), 0.0)
+        self.assertGreaterEqual(lines.max(), 1.0)
+        self.assertLessEqual(np.diff(lines).max(), 0.1 + 1e-12)
+        on_line = np.isin(np.round(points[:, 1], 9), lines)
+        self.assertLessEqual(points[on_line, 0].min(), -self.R)
+        self.assertGreaterEqual(points[on_line, 0].max(), 1.0 + self.R)
+        self.assertLessEqual(paths.gouge_depth, paths.eps)
+        program = paths.gcode()
+        self.assertEqual(gcode_problems(program), [])
+        self.assertIn("G20", program)
+        self.assertEqual(program.splitlines()[0], "(scallop tool path: scallop paths raster mesh)")
+        self.assertEqual(json.loads(paths.report_json)["source"], "mesh")
+
+    def test_plan_of_a_flat_square(self):
+        # Passes 0.1 apart leave cusps of R - sqrt(R^2 - 0.05^2) on a flat part.
+        plan = scallop.plan_mesh(self.square(), tool_radius=self.R, spacing=0.1, source="square")
+        cusp = self.R - math.sqrt(self.R ** 2 - 0.05 ** 2)
+        self.assertLessEqual(plan.max_gouge, 1e-5)  # the G-code's rounding
+        self.assertLessEqual(plan.max_scallop, cusp * 1.01 + 1e-5)
+        self.assertGreater(plan.max_scallop, cusp * 0.9)
+        files = plan.files()
+        self.assertEqual(list(files), ["toolpath.ngc", "report.json", "verify.svg"])
+        self.assertEqual(files["toolpath.ngc"], plan.program)
+        self.assertEqual(json.loads(files["report.json"])["source"], "square")
+        self.assertEqual(files["report.json"], plan.report_json)
+
+    def test_bad_meshes_are_refused(self):
+        with self.assertRaisesRegex(scallop.Error, "part-7"):  # vertex 9 of 4
+            scallop.plan_mesh(scallop.Mesh(self.SQUARE_VERTICES, [[0, 1, 9]]), source="part-7")
+        with self.assertRaisesRegex(scallop.Error, "triangle"):
+            scallop.mesh_paths(scallop.Mesh(self.SQUARE_VERTICES, np.zeros((0, 3), dtype=int)))
+        with self.assertRaisesRegex(ValueError, r"vertices: expected an array of shape \(n, 3\)"):
+            scallop.Mesh([[0.0, 0.0]], [[0, 0, 0]])
+        with self.assertRaisesRegex(ValueError, r"triangles: expected an array of shape \(m, 3\)"):
+            scallop.Mesh(self.SQUARE_VERTICES, [0, 1, 2])
+        with self.assertRaisesRegex(ValueError, "negative"):
+            scallop.Mesh(self.SQUARE_VERTICES, [[0, 1, -2]])
+        with self.assertRaisesRegex(TypeError, "integers"):
+            scallop.Mesh(self.SQUARE_VERTICES, [[0.0, 1.0, 2.0]])
+        with self.assertRaisesRegex(TypeError, "mesh: expected a scallop.Mesh"):
+            scallop.plan_mesh(scallop.Surface(FLAT_SQUARE))
+        with self.assertRaisesRegex(scallop.Error, "scallop height"):
+            scallop.plan_mesh(self.square(), tool_radius=self.R, scallop_height=2 * self.R)
+
+    def test_bad_stl_files_name_the_file(self):
+        with tempfile.TemporaryDirectory() as folder:
+            empty = write_file(folder, "empty.stl", b"")
+            with self.assertRaises(scallop.Error) as caught:
+                scallop.load_stl(empty)
+            self.assertIn(empty, str(caught.exception))
+            self.assertIn("empty", str(caught.exception))
+            # A binary STL cut short: 84 + 50 bytes of a file whose header counts 2 triangles.
+            truncated = write_file(folder, "cut.stl", b"\0" * 80 + (2).to_bytes(4, "little") + b"\0" * 50)
+            with self.assertRaisesRegex(scallop.Error, re.escape(truncated) + ".*truncated"):
+                scallop.load_stl(truncated)
+            # Three points on a line: refused, and the keyword that skips it named.
+            facet = "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex {}\nvertex {}\nendloop\nendfacet\n"
+            text = "solid s\n" + facet.format("1 0 0", "2 0 0") + facet.format("1 0 0", "0 1 0") + "endsolid s\n"
+            zero = write_file(folder, "zero.stl", text.encode())
+            with self.assertRaisesRegex(scallop.Error, re.escape(zero) + ".*zero area.*drop_zero_area=True"):
+                scallop.load_stl(zero)
+            read = scallop.load_stl(zero, units="in", drop_zero_area=True)
+            self.assertEqual((read.format, read.triangles_read, read.zero_area_dropped), ("ascii", 2, 1))
+            self.assertEqual(read.mesh.units, "in")
+            self.assertEqual(read.description, "1 triangles (ASCII STL)")
+            with self.assertRaisesRegex(scallop.Error, "missing.stl"):
+                scallop.load_stl(os.path.join(folder, "missing.stl"))
+            with self.assertRaisesRegex(ValueError, "units"):
+                scallop.load_stl(zero, units="m")
+
+
+@unittest.skipUnless(os.path.exists(SHAPE_STL) and scallop_cli(),
+                     "needs OCCT's sample parts (occt-misc) and the scallop program (SCALLOP_CLI)")
+class MeshPlanCliTest(unittest.TestCase):
+    """plan_mesh on OCCT's shape.stl against `scallop plan shape.stl`, byte for byte."""
+
+    R, H = 6.0, 0.3  # mm: about 1 s a plan
+    ARGUMENTS = ["--tool-radius", "6", "--scallop-height", "0.3"]
+
+    @classmethod
+    def setUpClass(cls):
+        with tempfile.TemporaryDirectory() as folder:
+            cls.cli_files, cls.cli_stages = cli_plan([SHAPE_STL, *cls.ARGUMENTS], folder)
+        cls.progress = []
+        cls.stl = scallop.load_stl(SHAPE_STL)
+        cls.plan = scallop.plan_mesh(cls.stl, tool_radius=cls.R, scallop_height=cls.H,
+                                     progress=lambda fraction, stage: cls.progress.append((fraction, stage)))
+
+    def test_the_files_are_the_cli_bytes(self):
+        files = self.plan.files()
+        self.assertEqual(sorted(files), sorted(self.cli_files))
+        self.assertEqual(list(files), ["toolpath.ngc", "report.json", "verify.svg"])
+        for name, contents in files.items():
+            self.assertEqual(contents.encode(), self.cli_files[name], name)
+
+    def test_progress_is_monotone_ends_at_one_and_names_the_cli_stages(self):
+        assert_progress(self, self.progress)
+        self.assertEqual(self.progress[0][1].split(";")[0], "494 triangles (ASCII STL)")
+        # The stages the CLI prints, but its own last line.
+        self.assertEqual(stages_of(self.progress), [s for s in self.cli_stages if s != "writing the report"])
+
+    def test_figures_agree_with_the_report(self):
+        plan = self.plan
+        report = json.loads(plan.report_json)
+        self.assertEqual(report["source"], SHAPE_STL)
+        self.assertEqual((plan.strategy, plan.units, plan.tool_radius, plan.scallop_height),
+                         ("raster", "mm", self.R, self.H))
+        self.assertEqual(report["verification"]["max_gouge"], plan.max_gouge)
+        self.assertEqual(plan.unproven_moves, 0)
+        self.assertLess(plan.max_gouge, 0.01)
+        self.assertLessEqual(plan.max_scallop, self.H)
+        self.assertEqual(plan.program_name, "toolpath.ngc")
+        self.assertEqual(gcode_problems(plan.program), [])
+        self.assertIn("G21", plan.program)  # mm
+        self.assertEqual(len(plan.passes), len(report["passes"]))
+
+    def test_mesh_paths_are_the_bytes_of_scallop_paths(self):
+        # The raster alone, as `scallop paths shape.stl --json --gcode` writes it; and the same
+        # from the mesh's own numpy arrays, named as the file.
+        with tempfile.TemporaryDirectory() as folder:
+            json_path, gcode_path = os.path.join(folder, "paths.json"), os.path.join(folder, "paths.ngc")
+            subprocess.run([scallop_cli(), "paths", SHAPE_STL, *self.ARGUMENTS, "--json", json_path,
+                            "--gcode", gcode_path], check=True, capture_output=True)
+            with open(json_path, "rb") as file:
+                cli_json = file.read()
+            with open(gcode_path, "rb") as file:
+                cli_gcode = file.read()
+        paths = scallop.mesh_paths(self.stl, tool_radius=self.R, scallop_height=self.H)
+        self.assertEqual(paths.report_json.encode(), cli_json)
+        self.assertEqual(paths.gcode().encode(), cli_gcode)
+        arrays = scallop.Mesh(self.stl.mesh.vertices, self.stl.mesh.triangles, units="mm")
+        again = scallop.mesh_paths(arrays, tool_radius=self.R, scallop_height=self.H, source=SHAPE_STL)
+        self.assertEqual(again.report_json, paths.report_json)
+        self.assertEqual(again.lines, self.plan.lines)  # the plan's raster, before its rest passes
+
+    def test_cancel_from_the_progress_callback(self):
+        token = scallop.CancelToken()
+        after = []
+
+        def progress(fraction, stage):
+            if token.cancelled:
+                after.append(stage)
+            elif fraction > 0.3:
+                token.cancel()
+
+        with self.assertRaises(scallop.Cancelled) as caught:
+            scallop.plan_mesh(self.stl, tool_radius=self.R, scallop_height=self.H, progress=progress, cancel=token)
+        self.assertIsInstance(caught.exception, scallop.Error)
+        self.assertTrue(token.cancelled)
+        self.assertNotIn("done", after)
+        # Cancelled before it starts: the raster alone too.
+        with self.assertRaises(scallop.Cancelled):
+            scallop.mesh_paths(self.stl, tool_radius=self.R, scallop_height=self.H, cancel=token)
+
+
+@unittest.skipUnless(scallop.has_cad and os.path.exists(SCREW_STEP) and scallop_cli(),
+                     "needs scallop::cad, OCCT's sample parts (occt-misc) and the scallop program (SCALLOP_CLI)")
+class PartPlanTest(unittest.TestCase):
+    """A STEP part through its tessellation, against `scallop plan screw.step`."""
+
+    def test_the_tessellated_part_gives_the_cli_bytes(self):
+        # 8 of the screw's 10 faces are trimmed: the CLI cuts it through its tessellation. The
+        # part here is a temporary: the tessellation keeps it alive for the judge.
+        progress = []
+        part = scallop.tessellate_part(scallop.CadPart(SCREW_STEP), tool_radius=6, spacing=6,
+                                       progress=lambda fraction, stage: progress.append((fraction, stage)))
+        self.assertEqual(progress[0][1], "tessellating its 10 faces with deflection 0.1 mm")  # the flat cusp / 8
+        self.assertEqual(progress[-1], (1.0, "done"))
+        self.assertEqual(part.warnings, [])  # a spacing: no H to warn about
+        self.assertEqual(part.faces, 10)
+        self.assertGreater(part.deviation, 0.0)
+        self.assertEqual(part.clearance, 1.5 * part.deviation)
+        self.assertEqual(part.mesh.units, "mm")
+        plan_progress = []
+        plan = scallop.plan_mesh(part, tool_radius=6, spacing=6,
+                                 progress=lambda fraction, stage: plan_progress.append((fraction, stage)))
+        assert_progress(self, plan_progress)
+        self.assertEqual(json.loads(plan.report_json)["tessellation"]["design"], "exact faces")
+        with tempfile.TemporaryDirectory() as folder:
+            cli_files, cli_stages = cli_plan([SCREW_STEP, "--tool-radius", "6", "--spacing", "6"], folder)
+        files = plan.files()
+        self.assertEqual(sorted(files), sorted(cli_files))
+        for name, contents in files.items():
+            self.assertEqual(contents.encode(), cli_files[name], name)
+        self.assertEqual(stages_of(progress) + stages_of(plan_progress),
+                         [s for s in cli_stages[1:] if s != "writing the report"])  # [0]: why it tessellates
+
+    def test_the_warning_names_the_keyword(self):
+        part = scallop.CadPart(SCREW_STEP)
+        self.assertEqual((part.format, part.units, part.faces), ("STEP", "mm", 10))
+        coarse = scallop.tessellate_part(part, deflection=0.2, tool_radius=3, scallop_height=0.05)
+        self.assertEqual(coarse.deflection, 0.2)
+        self.assertEqual(len(coarse.warnings), 1)
+        warning = coarse.warnings[0]
+        self.assertIn("3/4 of H = 0.05", warning)
+        self.assertIn("(a smaller deflection helps unless", warning)
+        self.assertNotIn("--deflection", warning)
+
+    def test_bad_parts(self):
+        with tempfile.TemporaryDirectory() as folder:
+            empty = write_file(folder, "empty.step", b"")
+            with self.assertRaisesRegex(scallop.Error, re.escape(empty)):
+                scallop.CadPart(empty)
+        part = scallop.CadPart(SCREW_STEP)
+        with self.assertRaisesRegex(scallop.Error, "deflection"):
+            scallop.tessellate_part(part, deflection=-1.0)
+        with self.assertRaisesRegex(scallop.Error, "at most one of a spacing and a scallop height"):
+            scallop.tessellate_part(part, spacing=1.0, scallop_height=0.1)
+        token = scallop.CancelToken()
+        token.cancel()
+        with self.assertRaises(scallop.Cancelled):
+            scallop.tessellate_part(part, tool_radius=6, spacing=6, cancel=token)
 
 
 if __name__ == "__main__":

@@ -67,9 +67,9 @@ TessellatedPart tessellatePart(const CadPart& part, const PartMeshOptions& optio
     out.warnings.push_back(fmt::format(
         "the exact faces stand up to {:.3g} {} from the mesh (face {}, near ({:.6g}, {:.6g}, {:.6g})), and the passes "
         "keep 1.5 times that farther: that leaves more than 3/4 of H = {}, so the scallops may exceed H (a smaller "
-        "--deflection helps unless the model's own tolerance is the cause)",
+        "{} helps unless the model's own tolerance is the cause)",
         mesh.deviation, unitsName(part.units()), mesh.deviationFace, mesh.deviationAt.x, mesh.deviationAt.y,
-        mesh.deviationAt.z, height));
+        mesh.deviationAt.z, height, options.deflectionOption));
   // The judge: the exact faces' heights, its budget the plan's (which only asks within it).
   out.exactHeights = [&part](HeightGrid& grid, std::vector<double>& normalZ) {
     ExactHeightOptions heights;

@@ -178,7 +178,16 @@ TEST(MeshPlan, ATessellatedPartsWarningIsReturnedNotPrinted) {
   const TessellatedPart tessellated = tessellatePart(part, options);
   ASSERT_EQ(tessellated.warnings.size(), 1u);
   test::expectMessageContains(tessellated.warnings.front(),
-                              {"the exact faces stand up to", "mm from the mesh (face ", "3/4 of H = 0.05"}, "warning");
+                              {"the exact faces stand up to", "mm from the mesh (face ", "3/4 of H = 0.05",
+                               "a smaller deflection (PartMeshOptions::deflection) helps"},
+                              "warning");
+  // A library caller has no --deflection flag: the warning names the option as it is told.
+  EXPECT_EQ(tessellated.warnings.front().find("--deflection"), std::string::npos) << tessellated.warnings.front();
+  options.deflectionOption = "--deflection";
+  const TessellatedPart flagged = tessellatePart(part, options);
+  ASSERT_EQ(flagged.warnings.size(), 1u);
+  EXPECT_NE(flagged.warnings.front().find("(a smaller --deflection helps unless"), std::string::npos)
+      << flagged.warnings.front();
   EXPECT_EQ(tessellated.deflection, 0.2);
   options.deflection.reset();  // H / 8: a fine mesh, and no warning... unless the model's own tolerance
   EXPECT_GT(tessellatePart(part, options).deflection, 0.0);

@@ -21,7 +21,9 @@
 //          for the plan's first stage, and warnings: one when the plan aims at H (no
 //          spacing) and clearance + deviation exceed 3/4 of H, naming the face and the point
 //          (the scallops may then exceed H; a smaller D helps unless the model's own
-//          tolerance is the cause, as on OCCT's bearing.iges).
+//          tolerance is the cause, as on OCCT's bearing.iges). The warning names the option
+//          that sets D as options.deflectionOption says: the library's field by default,
+//          the CLI's flag for `scallop plan`, a keyword for the Python module.
 // Units:   the part's (CadPart::units), for every length.
 // Errors:  scallop::Error: D, R, H or the spacing given but not positive and finite, H and a
 //          spacing both, a spacing of 2 R or more when D is derived from it (cusp.hpp's
@@ -35,6 +37,7 @@
 // Threads: the tessellation holds cad_import.hpp's process-wide mutex.
 
 #include <optional>
+#include <string>
 
 #include "scallop/cad/cad_tessellation.hpp"
 #include "scallop/job_control.hpp"
@@ -47,6 +50,9 @@ struct PartMeshOptions {
   std::optional<double> toolRadius;     ///< the plan's R; none: 0.25 in or 6 mm
   std::optional<double> scallopHeight;  ///< the plan's H; at most one of it and the spacing
   std::optional<double> spacing;        ///< the plan's spacing instead of H
+  /// How the warnings name the option that sets D ("a smaller <it> helps"): the caller's
+  /// own, e.g. "--deflection" for the CLI.
+  std::string deflectionOption = "deflection (PartMeshOptions::deflection)";
 };
 
 /// See the contract.
