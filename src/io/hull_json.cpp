@@ -58,6 +58,7 @@ Json statsJson(const ScallopHull& result, std::size_t vertexCount) {
   json["stack_pushes"] = result.stats.pushes;
   json["stack_pops"] = result.stats.pops;
   json["comparisons"] = result.stats.comparisons;
+  json["exact_steps"] = result.stats.exactSteps;
   return json;
 }
 

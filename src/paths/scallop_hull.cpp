@@ -492,6 +492,325 @@ bool dominatesPiece(const Capsule& K, const StackEntry& top, std::span<const Poi
   return K.top(x) >= T.top(x);
 }
 
+void exactStep(std::span<const Point2> chain, std::size_t k, double r, double tau, double band,
+               double verticalRun, std::vector<StackEntry>& stack, HullStats& stats);
+
+// The filtered pass: the same stack of capsules, built on "units" (README, Performance).
+//
+// A unit is an edge's offset line followed by the arc around its end vertex (unit -1: the arc
+// around v_0 alone), so that every vertex arc is in exactly one unit and a unit's top is one
+// line and one arc. By the ordering of contacts (scallop_hull.hpp) units appear along the
+// envelope in chain order, each on one interval, and a new unit U_k takes over from one
+// crossing onward: it covers a stacked unit's piece when that piece's start P lies right of
+// U_k's first point s0 and within r of edge k (P is on the envelope, above the capsule's lower
+// boundary, so inside the capsule means below its top, which right of s0 is U_k's). Which
+// pair of stretches crosses is read from at most two side tests at the units' junctions, and
+// only that pair is solved, with featureRoots and the very features the exact pass gives it,
+// so that each crossing comes out bit for bit as that pass computes it.
+//
+// The units are written out as the exact pass's capsule stack: a unit's line belongs to its
+// edge's capsule; its arc to the next edge's capsule once that capsule has taken over at the
+// convex vertex (the exact pass gives a vertex arc to the later of its two edges then, and
+// keeps that capsule while its start is not covered, even when the next unit's is), and to
+// its own capsule otherwise. A unit's entries are written when the next unit, which ends its
+// piece, is pushed.
+//
+// An edge the filters cannot decide (a vertical edge, a tie within rounding that a side test
+// cannot tell, a crossing not found on the one pair, a crossing with what lies below the
+// units) is handed to the exact pass: the capsule stack is completed and exactStep adds the
+// edge. The units start again above what the exact pass built once its top is a capsule that
+// starts on its own line or end arc and does not jump; until then the next edges go to the
+// exact pass too. The decisions the filtered pass does take are the exact pass's but at ties
+// within rounding, which the two may break differently (the exact pass compares the tops a
+// little to the right of a piece's start, which can land where two capsules share a vertex
+// arc, past a line piece shorter than that step); tests/paths/scallop_hull_test.cpp compares
+// the two bit for bit and, where they differ, within the tolerance.
+// Drops the elements from `size` on (no growth: cheaper than resize on the hot path).
+template <typename T>
+void truncate(std::vector<T>& v, std::size_t size) {
+  v.erase(v.begin() + static_cast<std::ptrdiff_t>(size), v.end());
+}
+
+class UnitPass {
+ public:
+  UnitPass(std::span<const Point2> chain, double r, double tau, double band, double verticalRun)
+      : chain_(chain), v_(chain.data()), n_(static_cast<long>(chain.size())), r_(r), tau_(tau),
+        band_(band), verticalRun_(verticalRun) {}
+
+  std::vector<StackEntry> run(HullStats& stats) {
+    std::vector<StackEntry> capsules;
+    capsules.reserve(std::min<std::size_t>(chain_.size(), std::size_t{1} << 20));
+    capsules_ = &capsules;
+    stats_ = &stats;
+    units_.reserve(std::min<std::size_t>(chain_.size(), std::size_t{1} << 20));
+    units_.push_back({kBottom, 0.0, 0.0, 0.0, 1.0, 0, false});
+    units_.push_back({-1, v_[0].x - r_, v_[0].z, 0.0, 1.0, 0, false});
+    for (long k = 0; k + 1 < n_; ++k) {
+      if (units_.size() > 1 && addUnit(k)) continue;
+      handToExactPass(k);
+    }
+    if (units_.size() > 1) finalize(units_.back(), -1, true);
+    return capsules;
+  }
+
+ private:
+  static constexpr long kBottom = -2;  // the unit below all others: what the exact pass built
+
+  struct Unit {
+    long edge;      // -1: the arc around v_0; e >= 0: edge e's offset line, then the arc around v_{e+1}
+    double x, z;    // where the unit takes over the envelope
+    double nx, nz;  // edge e's upward unit normal (makeCapsule's)
+    std::size_t capsuleStart;  // where its capsule entries begin in the capsule stack
+    bool continues;            // its line continues the capsule entry the unit before wrote
+    // Whether its arc went to the next edge's capsule (which took over at the convex vertex),
+    // and that edge's normal.
+    bool handed = false;
+    double handedNx = 0.0;
+    double handedNz = 0.0;
+  };
+
+  [[nodiscard]] double lineEndX(const Unit& u) const { return v_[u.edge + 1].x + r_ * u.nx; }
+  [[nodiscard]] Feature lineFeature(long edge, double nx, double nz) const {
+    const Point2& a = v_[edge];
+    const Point2& b = v_[edge + 1];
+    return {false, {a.x + r_ * nx, a.z + r_ * nz}, b.x - a.x, b.z - a.z};
+  }
+  [[nodiscard]] Feature arcFeature(long vertex) const { return {true, v_[vertex], 0.0, 0.0}; }
+
+  // The unit's top at x (its line, else its arc; -infinity outside its reach).
+  [[nodiscard]] double top(const Unit& u, double x) const {
+    const Point2& c = v_[u.edge + 1];
+    if (u.edge >= 0) {
+      const Point2& a = v_[u.edge];
+      if (x < a.x + r_ * u.nx) return -std::numeric_limits<double>::infinity();
+      if (x <= c.x + r_ * u.nx) return capsuleWithNormal(a, c, r_, u.nx, u.nz).top(x);
+    }
+    if (std::abs(x - c.x) > r_) return -std::numeric_limits<double>::infinity();
+    return arcTop(c, r_, x);
+  }
+
+  // Writes unit u's capsule entries, its piece ending at the next unit (edge nextEdge, or -1
+  // at the end of the chain) on u's arc (endsOnArc) or on its line. Sets continues_ for the
+  // next unit.
+  void finalize(const Unit& u, long nextEdge, bool endsOnArc) {
+    std::vector<StackEntry>& capsules = *capsules_;
+    truncate(capsules, u.capsuleStart);
+    if (u.edge < 0) {
+      // The arc around v_0 starts capsule 0; the next unit continues it if it is unit 0.
+      capsules.push_back({0, u.x, u.z, firstNx_, firstNz_, false});
+      continues_ = nextEdge == 0;
+      return;
+    }
+    const std::size_t edge = static_cast<std::size_t>(u.edge);
+    const double s1 = lineEndX(u);
+    const bool hasLine = u.x < s1;
+    if (hasLine && !u.continues) capsules.push_back({edge, u.x, u.z, u.nx, u.nz, false});
+    continues_ = false;
+    if (endsOnArc && u.handed) {
+      // The arc around v_{e+1} is the next capsule's, from where the line ends.
+      if (hasLine) {
+        capsules.push_back({edge + 1, s1, v_[u.edge + 1].z + r_ * u.nz, u.handedNx, u.handedNz, false});
+      } else {
+        capsules.push_back({edge + 1, u.x, u.z, u.handedNx, u.handedNz, false});
+      }
+      continues_ = nextEdge == u.edge + 1;
+    } else if (!hasLine && !u.continues) {
+      capsules.push_back({edge, u.x, u.z, u.nx, u.nz, false});
+    }
+  }
+
+  // Pops `pops` units, then pushes unit k at (x, z), ending the piece of the unit below on
+  // its arc or its line.
+  struct UnitNormal {
+    double nx, nz;
+  };
+
+  void commit(std::size_t pops, long k, double x, double z, const UnitNormal& K, bool topEndsOnArc) {
+    truncate(units_, units_.size() - pops);
+    stats_->pops += pops;
+    finalize(units_.back(), k, topEndsOnArc);
+    units_.push_back({k, x, z, K.nx, K.nz, capsules_->size(), continues_});
+    ++stats_->pushes;
+  }
+
+  // The edge goes to the exact pass; the units start again above its stack when they can.
+  void handToExactPass(long k) {
+    // The stack as the exact pass has it after edge k-1 (before edge 0 it is empty: the arc
+    // around v_0 is capsule 0's, which exactStep adds).
+    if (units_.size() > 1 && units_.back().edge >= 0) finalize(units_.back(), -1, true);
+    units_.clear();
+    const std::size_t edge = static_cast<std::size_t>(k);
+    exactStep(chain_, edge, r_, tau_, band_, verticalRun_, *capsules_, *stats_);
+    ++stats_->exactSteps;
+    const StackEntry& top = capsules_->back();
+    if (top.edge != edge || top.jump) return;
+    const Capsule K = makeCapsule(v_[k], v_[k + 1], r_, verticalRun_);
+    if (K.vertical || stretchOf(K, {top.x, top.z}) == Stretch::arcA) return;
+    if (k == 0) {
+      firstNx_ = K.nx;
+      firstNz_ = K.nz;
+    }
+    units_.push_back({kBottom, 0.0, 0.0, 0.0, 1.0, capsules_->size() - 1, false});
+    units_.push_back({k, top.x, top.z, K.nx, K.nz, capsules_->size() - 1, false});
+  }
+
+  // Adds unit k when the filters decide every step; false (nothing changed) otherwise.
+  bool addUnit(long k) {
+    const Point2& a = v_[k];
+    const Point2& b = v_[k + 1];
+    // makeCapsule's normal and offset line, computed the same way, without the rest of it.
+    const double dx = b.x - a.x;
+    const double dz = b.z - a.z;
+    if (!(dx > verticalRun_)) return false;  // vertical (makeCapsule's test)
+    const double length = std::sqrt(dx * dx + dz * dz);
+    if (!(length > 0.0) || !std::isfinite(length)) return false;
+    const UnitNormal K{-dz / length, dx / length};
+    if (k == 0) {
+      firstNx_ = K.nx;
+      firstNz_ = K.nz;
+    }
+    const double s0 = a.x + r_ * K.nx;
+    const double s1 = b.x + r_ * K.nx;
+
+    // Backward exclusion, decided before anything changes.
+    std::size_t pops = 0;
+    double pieceEnd = 0.0;  // the top unit's piece ends at the last popped start
+    while (true) {
+      const Unit& t = units_[units_.size() - 1 - pops];
+      if (t.edge == kBottom) return false;
+      ++stats_->comparisons;
+      if (t.x < s0) break;
+      int side = sideOfCapsule({t.x, t.z}, a, b, r_, band_);
+      if (side == 0) {
+        // Too close to tell (a contact shared within rounding): compare the tops a little to
+        // the right, inside the piece, as dominatesPiece does.
+        const double end = pops > 0 ? pieceEnd : v_[t.edge + 1].x + r_;
+        const double x = t.x + 1e-6 * std::max(0.0, end - t.x);
+        if (x > b.x + r_) return false;
+        side = capsuleWithNormal(a, b, r_, K.nx, K.nz).top(x) >= top(t, x) ? -1 : 1;
+      }
+      if (side > 0) break;
+      pieceEnd = t.x;
+      ++pops;
+    }
+    const Unit& t = units_[units_.size() - 1 - pops];
+    if (t.edge == kBottom) return false;
+
+    if (pops == 0) {
+      // The top is unit k-1, whose arc around a = v_k ends the envelope so far.
+      if (t.edge != k - 1) return false;
+      if (k == 0) {
+        commit(0, k, s0, a.z + r_ * K.nz, K, true);
+        return true;
+      }
+      const Point2& p = v_[k - 1];
+      const double turn = (a.x - p.x) * (b.z - a.z) - (a.z - p.z) * (b.x - a.x);
+      if (turn <= 0.0) {
+        // Convex at v_k: the new line leaves the arc around v_k at its tangent point, and the
+        // arc is capsule k's.
+        if (!(s0 > t.x)) return false;
+        Unit& handing = units_.back();
+        handing.handed = true;
+        handing.handedNx = K.nx;
+        handing.handedNz = K.nz;
+        commit(0, k, s0, a.z + r_ * K.nz, K, true);
+        return true;
+      }
+      // Concave at v_k (slope-slope, Figure 6a): the exact pass's closed form and tests.
+      const Capsule T = capsuleWithNormal(p, a, r_, t.nx, t.nz);
+      const double denom = 1.0 + T.nx * K.nx + T.nz * K.nz;
+      if (denom > 1e-8) {
+        const Point2 q{T.b.x + r_ * (T.nx + K.nx) / denom, T.b.z + r_ * (T.nz + K.nz) / denom};
+        const double tT = projectOnLine(T, q);
+        const double tK = projectOnLine(capsuleWithNormal(a, b, r_, K.nx, K.nz), q);
+        if (q.x >= t.x && tT >= 0.0 && tT <= 1.0 && tK >= 0.0 && tK <= 1.0) {
+          commit(0, k, q.x, q.z, K, false);
+          return true;
+        }
+      }
+      pieceEnd = a.x + r_;  // otherwise the crossing below, over the top's whole piece
+    }
+
+    // The crossing of U_k with the top unit U_j on its piece (t.x, pieceEnd).
+    const long j = t.edge;
+    const double topS1 = j >= 0 ? lineEndX(t) : -std::numeric_limits<double>::infinity();
+    bool topOnLine = j >= 0 && t.x < topS1;
+    if (topOnLine && topS1 < pieceEnd) {
+      // The top's junction (its line's end) is on the envelope: inside capsule k, the
+      // crossing is before it, on the top's line.
+      if (topS1 < s0) {
+        topOnLine = false;
+      } else {
+        const int side = sideOfCapsule({topS1, v_[j + 1].z + r_ * t.nz}, a, b, r_, band_);
+        if (side == 0) return false;
+        topOnLine = side < 0;
+      }
+    }
+    // The new unit's stretch: its line if U_k is above the top's stretch where that line
+    // ends (the crossing is then left of it), else its arc around b.
+    bool newOnLine = true;
+    if (s1 <= t.x) {
+      newOnLine = false;
+    } else if (s1 < pieceEnd) {
+      const Point2 junction{s1, b.z + r_ * K.nz};
+      const Point2& c = v_[j + 1];
+      double side;
+      double sideBand;
+      if (topOnLine) {
+        const Point2& p = v_[j];
+        side = (junction.z - (c.z + r_ * t.nz)) * (c.x - p.x) - (junction.x - topS1) * (c.z - p.z);
+        sideBand = 4.0 * band_ * (std::abs(c.x - p.x) + std::abs(c.z - p.z));
+      } else {
+        const double ux = junction.x - c.x;
+        const double uz = junction.z - c.z;
+        side = std::abs(ux) > r_ ? 1.0 : circleExcess(ux, uz, r_);
+        sideBand = 4.0 * r_ * band_;
+      }
+      if (std::abs(side) <= sideBand) return false;
+      newOnLine = side > 0.0;
+    }
+    const Feature f = topOnLine ? lineFeature(j, t.nx, t.nz) : arcFeature(j + 1);
+    const Feature g = newOnLine ? lineFeature(k, K.nx, K.nz) : arcFeature(k + 1);
+    if (f.isArc && g.isArc && f.point == g.point) return false;
+    std::array<Point2, 2> roots{};
+    const int count = featureRoots(f, g, r_, roots);
+    // The one root on both stretches, inside the piece, where U_k rises through the top.
+    int found = -1;
+    for (int i = 0; i < count; ++i) {
+      const Point2& q = roots[i];
+      const double margin = 32.0 * std::numeric_limits<double>::epsilon() * (r_ + std::abs(q.x));
+      if (!(q.x > t.x + margin && q.x < pieceEnd - margin)) continue;
+      if (newOnLine ? !(q.x > s0 + margin && q.x < s1 - margin) : !(q.x > s1 + margin)) continue;
+      if (topOnLine ? !(q.x < topS1 - margin) : !(q.x > topS1 + margin)) continue;
+      // Rising: the clockwise tangent of U_k turns up from the top's (quickCrossing's test).
+      const Point2 u = f.isArc ? Point2{q.z - f.point.z, f.point.x - q.x} : Point2{f.dx, f.dz};
+      const Point2 w = g.isArc ? Point2{q.z - g.point.z, g.point.x - q.x} : Point2{g.dx, g.dz};
+      const double turn = u.x * w.z - u.z * w.x;
+      if (!(turn > 0.0 && turn * turn > 1e-18 * (u.x * u.x + u.z * u.z) * (w.x * w.x + w.z * w.z))) continue;
+      if (found >= 0) return false;  // two: a tangency the exact pass must settle
+      found = i;
+    }
+    if (found < 0) return false;
+    const Point2 q = roots[static_cast<std::size_t>(found)];
+    commit(pops, k, q.x, q.z, K, !topOnLine);
+    return true;
+  }
+
+  std::span<const Point2> chain_;
+  const Point2* v_;
+  long n_;
+  double r_;
+  double tau_;
+  double band_;
+  double verticalRun_;
+  double firstNx_ = 0.0;
+  double firstNz_ = 1.0;
+  bool continues_ = false;
+  std::vector<Unit> units_;
+  std::vector<StackEntry>* capsules_ = nullptr;
+  HullStats* stats_ = nullptr;
+};
+
 // Builds the tool path and the hull from the envelope: the stack lists the capsules that
 // form c(x), each from its start to the next one's start.
 HullElement pointHull(std::span<const Point2> chain) {
@@ -730,6 +1049,110 @@ class OutputBuilder {
   Point2 contact_;  // current contact point on the chain
 };
 
+// The exact pass: capsules added left to right on a stack (scallop_hull.hpp, Method), every
+// case decided, with vertical edges and ties within rounding.
+// One step of the exact pass: capsule k added to the stack (scallop_hull.hpp, Method), every
+// case decided, with vertical edges and ties within rounding.
+void exactStep(std::span<const Point2> chain, std::size_t k, double r, double tau, double band,
+               double verticalRun, std::vector<StackEntry>& stack, HullStats& stats) {
+  auto push = [&](std::size_t edge, double x, double z, const Capsule& c, bool jump = false) {
+    stack.push_back({edge, x, z, c.nx, c.nz, jump});
+    ++stats.pushes;
+  };
+  const Capsule K = makeCapsule(chain[k], chain[k + 1], r, verticalRun);
+  // Backward exclusion: K covers the whole piece of the top capsule when it is on or above
+  // it where that piece starts (contacts are ordered, so K stays above from there on).
+  double poppedFrom = K.left();
+  bool poppedJump = false;
+  const std::size_t entriesBeforePops = stack.size() + 1;
+  while (!stack.empty()) {
+    const StackEntry& top = stack.back();
+    ++stats.comparisons;
+    if (!dominatesPiece(K, stack.back(), chain, r, band,
+                        stack.size() + 1 == entriesBeforePops ? K.right() : poppedFrom)) {
+      break;
+    }
+    poppedFrom = top.x;
+    poppedJump = top.jump;
+    stack.pop_back();
+    ++stats.pops;
+  }
+  if (stack.empty()) {
+    push(k, poppedFrom, K.top(poppedFrom), K);
+    return;
+  }
+  const StackEntry& top = stack.back();
+  const Capsule T =
+      capsuleWithNormal(chain[top.edge], chain[top.edge + 1], r, top.nx, top.nz);
+  const double hi = T.right();
+  const double lo = std::min(std::max(top.x, K.left()), hi);
+  ++stats.comparisons;
+  if (top.edge + 1 == k && !T.vertical && !K.vertical) {
+    // Adjacent edges meeting at v = chain[k]: K's capsule holds the disk around v, so K is
+    // above T where T ends, and the hand-over is known in closed form.
+    const double turn =
+        (T.b.x - T.a.x) * (K.b.z - K.a.z) - (T.b.z - T.a.z) * (K.b.x - K.a.x);
+    if (turn <= 0.0) {
+      // Convex (or straight) at v: both capsules are the arc around v between the two
+      // offset lines, so K takes over where T's offset line ends.
+      if (T.s1 >= lo && T.s1 <= hi) {
+        push(k, T.s1, T.b.z + r * T.nz, K);
+      } else {
+        const double start = std::clamp(T.s1, lo, hi);
+        push(k, start, K.top(start), K);
+      }
+      return;
+    }
+    // Concave at v (slope-slope, Figure 6a): the offset lines meet at
+    // v + r (n_T + n_K) / (1 + n_T . n_K), the centre at distance r from both lines.
+    // It is the hand-over if it lies on both offset lines' segments (tested by projection,
+    // which a near-vertical line's x range cannot do).
+    const double denom = 1.0 + T.nx * K.nx + T.nz * K.nz;
+    if (denom > 1e-8) {
+      const Point2 q{T.b.x + r * (T.nx + K.nx) / denom, T.b.z + r * (T.nz + K.nz) / denom};
+      const double tT = projectOnLine(T, q);
+      const double tK = projectOnLine(K, q);
+      if (q.x >= lo && tT >= 0.0 && tT <= 1.0 && tK >= 0.0 && tK <= 1.0) {
+        push(k, q.x, q.z, K);
+        return;
+      }
+    }
+  } else if (!isBelowTop(K, hi, T.upperEndAtRight().z)) {
+    // K is below T where T ends: it takes over only beyond T's reach (the ball drops
+    // along a vertical edge there), or never.
+    if (K.right() > hi) push(k, hi, K.top(hi), K, true);
+    return;
+  }
+  const std::optional<Point2> quick = quickCrossing(T, K, lo, hi);
+  const Point2 handOver =
+      quick ? *quick
+            : crossing(T, K, lo, hi, lo == top.x ? top.z : T.top(lo), T.upperEndAtRight().z);
+  const double start = handOver.x;
+  // Taking over where K begins, K may start above T: the ball climbs a vertical edge (K's
+  // own, or one K has just covered). Taking over where T began, T's piece is empty and K
+  // inherits its hand-over; likewise where a popped piece began.
+  // (Equal up to rounding: the abscissae come from different sums.)
+  const double margin = xMargin(K, handOver);
+  const bool jump = (start <= K.left() + margin && K.top(start) > handOver.z + tau) ||
+                    (std::abs(start - top.x) <= margin && top.jump) ||
+                    (std::abs(start - poppedFrom) <= margin && poppedJump);
+  // After a jump the piece starts at K's own height there; otherwise at the crossing
+  // point, computed on the curves themselves (well conditioned on a near-vertical line).
+  push(k, start, jump ? K.top(start) : handOver.z, K, jump);
+}
+
+// The exact pass alone over the whole chain.
+std::vector<StackEntry> exactPass(std::span<const Point2> chain, double r, double tau, double band,
+                                  double verticalRun, HullStats& stats) {
+  std::vector<StackEntry> stack;
+  stack.reserve(std::min<std::size_t>(chain.size(), std::size_t{1} << 20));
+  for (std::size_t k = 0; k + 1 < chain.size(); ++k) {
+    exactStep(chain, k, r, tau, band, verticalRun, stack, stats);
+    ++stats.exactSteps;
+  }
+  return stack;
+}
+
 std::vector<std::size_t> monotoneUpperHull(std::span<const Point2> chain, HullStats& stats) {
   // Andrew's monotone chain over points already ordered by x. Ties in x (vertical edges)
   // and repeated points need care: the turn test must compare a vertex with the last
@@ -800,7 +1223,7 @@ std::vector<std::size_t> upperHullIndices(std::span<const Point2> chain) {
   return monotoneUpperHull(chain, unused);
 }
 
-ScallopHull scallopHull(std::span<const Point2> chain, double radius) {
+ScallopHull scallopHull(std::span<const Point2> chain, double radius, HullMethod method) {
   validateChain(chain);
   if (!(radius > 0.0)) {
     throw Error(fmt::format("the radius must be a positive number, got {}", radius));
@@ -826,96 +1249,9 @@ ScallopHull scallopHull(std::span<const Point2> chain, double radius) {
   // Distances are known to about this much (a few ulps of the coordinates and of r).
   const double band = 64.0 * std::numeric_limits<double>::epsilon() * (scale + r);
 
-  std::vector<StackEntry> stack;
-  stack.reserve(std::min<std::size_t>(chain.size(), std::size_t{1} << 20));
-  HullStats& stats = out.stats;
-  auto push = [&](std::size_t edge, double x, double z, const Capsule& c, bool jump = false) {
-    stack.push_back({edge, x, z, c.nx, c.nz, jump});
-    ++stats.pushes;
-  };
-  for (std::size_t k = 0; k + 1 < chain.size(); ++k) {
-    const Capsule K = makeCapsule(chain[k], chain[k + 1], r, verticalRun);
-    // Backward exclusion: K covers the whole piece of the top capsule when it is on or above
-    // it where that piece starts (contacts are ordered, so K stays above from there on).
-    double poppedFrom = K.left();
-    bool poppedJump = false;
-    const std::size_t entriesBeforePops = stack.size() + 1;
-    while (!stack.empty()) {
-      const StackEntry& top = stack.back();
-      ++stats.comparisons;
-      if (!dominatesPiece(K, stack.back(), chain, r, band,
-                          stack.size() + 1 == entriesBeforePops ? K.right() : poppedFrom)) {
-        break;
-      }
-      poppedFrom = top.x;
-      poppedJump = top.jump;
-      stack.pop_back();
-      ++stats.pops;
-    }
-    if (stack.empty()) {
-      push(k, poppedFrom, K.top(poppedFrom), K);
-      continue;
-    }
-    const StackEntry& top = stack.back();
-    const Capsule T =
-        capsuleWithNormal(chain[top.edge], chain[top.edge + 1], r, top.nx, top.nz);
-    const double hi = T.right();
-    const double lo = std::min(std::max(top.x, K.left()), hi);
-    ++stats.comparisons;
-    if (top.edge + 1 == k && !T.vertical && !K.vertical) {
-      // Adjacent edges meeting at v = chain[k]: K's capsule holds the disk around v, so K is
-      // above T where T ends, and the hand-over is known in closed form.
-      const double turn =
-          (T.b.x - T.a.x) * (K.b.z - K.a.z) - (T.b.z - T.a.z) * (K.b.x - K.a.x);
-      if (turn <= 0.0) {
-        // Convex (or straight) at v: both capsules are the arc around v between the two
-        // offset lines, so K takes over where T's offset line ends.
-        if (T.s1 >= lo && T.s1 <= hi) {
-          push(k, T.s1, T.b.z + r * T.nz, K);
-        } else {
-          const double start = std::clamp(T.s1, lo, hi);
-          push(k, start, K.top(start), K);
-        }
-        continue;
-      }
-      // Concave at v (slope-slope, Figure 6a): the offset lines meet at
-      // v + r (n_T + n_K) / (1 + n_T . n_K), the centre at distance r from both lines.
-      // It is the hand-over if it lies on both offset lines' segments (tested by projection,
-      // which a near-vertical line's x range cannot do).
-      const double denom = 1.0 + T.nx * K.nx + T.nz * K.nz;
-      if (denom > 1e-8) {
-        const Point2 q{T.b.x + r * (T.nx + K.nx) / denom, T.b.z + r * (T.nz + K.nz) / denom};
-        const double tT = projectOnLine(T, q);
-        const double tK = projectOnLine(K, q);
-        if (q.x >= lo && tT >= 0.0 && tT <= 1.0 && tK >= 0.0 && tK <= 1.0) {
-          push(k, q.x, q.z, K);
-          continue;
-        }
-      }
-    } else if (!isBelowTop(K, hi, T.upperEndAtRight().z)) {
-      // K is below T where T ends: it takes over only beyond T's reach (the ball drops
-      // along a vertical edge there), or never.
-      if (K.right() > hi) push(k, hi, K.top(hi), K, true);
-      continue;
-    }
-    const std::optional<Point2> quick = quickCrossing(T, K, lo, hi);
-    const Point2 handOver =
-        quick ? *quick
-              : crossing(T, K, lo, hi, lo == top.x ? top.z : T.top(lo), T.upperEndAtRight().z);
-    const double start = handOver.x;
-    // Taking over where K begins, K may start above T: the ball climbs a vertical edge (K's
-    // own, or one K has just covered). Taking over where T began, T's piece is empty and K
-    // inherits its hand-over; likewise where a popped piece began.
-    // (Equal up to rounding: the abscissae come from different sums.)
-    const double margin = xMargin(K, handOver);
-    const bool jump = (start <= K.left() + margin && K.top(start) > handOver.z + tau) ||
-                      (std::abs(start - top.x) <= margin && top.jump) ||
-                      (std::abs(start - poppedFrom) <= margin && poppedJump);
-    // After a jump the piece starts at K's own height there; otherwise at the crossing
-    // point, computed on the curves themselves (well conditioned on a near-vertical line).
-    push(k, start, jump ? K.top(start) : handOver.z, K, jump);
-  }
-
+  const std::vector<StackEntry> stack =
+      method == HullMethod::automatic ? UnitPass(chain, r, tau, band, verticalRun).run(out.stats)
+                                      : exactPass(chain, r, tau, band, verticalRun, out.stats);
   out.toolpath.reserve(2 * stack.size() + 4);
   out.hull.reserve(2 * stack.size() + 4);
   OutputBuilder(chain, r, tau, out).build(stack);

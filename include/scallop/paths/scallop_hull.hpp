@@ -42,6 +42,15 @@
 // of the current hull: the paper's Backward_Exclusion) or is covered entirely. The crossing
 // of two capsules is one of the paper's support pairs: arc-arc = peak-peak, arc-line =
 // peak-slope, line-line = slope-slope (Figure 6), solved in closed form.
+//
+// Two passes build that stack. The filtered pass (HullMethod::automatic, the default) adds
+// "units" instead of capsules, an edge's offset line with the arc around its end vertex, and
+// solves only the one support pair that side tests at the units' junctions point to. An edge
+// it cannot decide (a vertical edge, a tie its filters cannot tell) goes to the exact pass,
+// which decides every case, and the units start again above what it built. The two give the
+// same result bit for bit but where they break a tie within rounding differently (2 of 23,335
+// test chains, with near-duplicate points); both are within the tolerance below
+// (HullMethod::exact runs the exact pass alone; tests/paths/scallop_hull_test.cpp compares).
 
 #include <cstddef>
 #include <cstdint>
@@ -83,11 +92,18 @@ struct PathElement {
 };
 
 /// Counters for the linear-time claim: pushes and pops of edges on the hull stack, and
-/// capsule comparisons (each costs O(1)).
+/// capsule comparisons (each costs O(1)), of the pass that built the hull.
 struct HullStats {
   std::uint64_t pushes = 0;
   std::uint64_t pops = 0;
   std::uint64_t comparisons = 0;
+  std::uint64_t exactSteps = 0;  ///< edges the exact pass added (all of them with HullMethod::exact)
+};
+
+/// Which pass builds the stack (see Method above).
+enum class HullMethod {
+  automatic,  ///< the filtered pass, the exact pass where it gives up (the same result)
+  exact,      ///< the exact pass alone: for comparisons and tests
 };
 
 struct ScallopHull {
@@ -101,7 +117,8 @@ constexpr double kInfiniteRadius = std::numeric_limits<double>::infinity();
 
 /// The scallop hull of `chain` for a circle of radius `radius` (> 0, may be +infinity) and
 /// its offset. Throws scallop::Error on an invalid chain (see validateChain) or radius.
-ScallopHull scallopHull(std::span<const Point2> chain, double radius);
+ScallopHull scallopHull(std::span<const Point2> chain, double radius,
+                        HullMethod method = HullMethod::automatic);
 
 /// Indices of the vertices of the upper convex hull of a chain with non-decreasing x
 /// (Andrew's monotone chain, one pass, O(n)); collinear vertices on hull edges are kept,
