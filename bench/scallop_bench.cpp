@@ -1,6 +1,8 @@
 // scallop-bench: the scallop hull beside its peers, in one run and one binary, so that the
 // ratios survive a noisy machine.
 //   BM_ScallopHull/<n>         scallopHull on a fixed-seed random-walk chain of n vertices
+//   BM_ScallopHullExact/<n>    the same with HullMethod::exact (the exact pass alone, as the
+//                              hull was before the filtered pass)
 //   BM_UpperHull/<n>           Andrew's monotone-chain upper hull of the same chain: the
 //                              r = infinity limit, and the natural floor for a stack pass
 //   BM_BruteForceEnvelope/<n>  the envelope sampled at the n vertex abscissae by taking the
@@ -60,6 +62,15 @@ void BM_ScallopHull(benchmark::State& state) {
   const Chain& chain = randomWalk(static_cast<std::size_t>(state.range(0)));
   for (auto _ : state) {
     scallop::ScallopHull result = scallop::scallopHull(chain, kRadius);
+    benchmark::DoNotOptimize(result.toolpath.data());
+  }
+  state.SetItemsProcessed(state.iterations() * state.range(0));
+}
+
+void BM_ScallopHullExact(benchmark::State& state) {
+  const Chain& chain = randomWalk(static_cast<std::size_t>(state.range(0)));
+  for (auto _ : state) {
+    scallop::ScallopHull result = scallop::scallopHull(chain, kRadius, scallop::HullMethod::exact);
     benchmark::DoNotOptimize(result.toolpath.data());
   }
   state.SetItemsProcessed(state.iterations() * state.range(0));
@@ -382,6 +393,7 @@ BENCHMARK_CAPTURE(BM_OrientCircle, paper2_100k_full, "paper-2", 4e-7, false)->It
 BENCHMARK(BM_MedialAxis)->Arg(1000)->Arg(10000)->Arg(100000)->Unit(benchmark::kMillisecond);
 
 BENCHMARK(BM_ScallopHull)->RangeMultiplier(2)->Range(1 << 10, 1 << 23)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ScallopHullExact)->Arg(1 << 10)->Arg(1 << 14)->Arg(1 << 20)->Arg(1 << 23)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_UpperHull)->RangeMultiplier(2)->Range(1 << 10, 1 << 23)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_HullOutputCopy)->Arg(1 << 10)->Arg(1 << 14)->Arg(1 << 20)->Arg(1 << 23)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_EdgeNormals)->Arg(1 << 10)->Arg(1 << 14)->Arg(1 << 20)->Arg(1 << 23)->Unit(benchmark::kMillisecond);
