@@ -3,6 +3,8 @@
 //   BM_ScallopHull/<n>         scallopHull on a fixed-seed random-walk chain of n vertices
 //   BM_ScallopHullExact/<n>    the same with HullMethod::exact (the exact pass alone, as the
 //                              hull was before the filtered pass)
+//   BM_ScallopHullWalls/<n>    the walk with every 97th edge vertical: the filtered pass
+//                              hands those to the exact pass and starts again (linear still)
 //   BM_UpperHull/<n>           Andrew's monotone-chain upper hull of the same chain: the
 //                              r = infinity limit, and the natural floor for a stack pass
 //   BM_BruteForceEnvelope/<n>  the envelope sampled at the n vertex abscissae by taking the
@@ -72,6 +74,21 @@ void BM_ScallopHullExact(benchmark::State& state) {
   for (auto _ : state) {
     scallop::ScallopHull result = scallop::scallopHull(chain, kRadius, scallop::HullMethod::exact);
     benchmark::DoNotOptimize(result.toolpath.data());
+  }
+  state.SetItemsProcessed(state.iterations() * state.range(0));
+}
+
+void BM_ScallopHullWalls(benchmark::State& state) {
+  Chain chain = randomWalk(static_cast<std::size_t>(state.range(0)));
+  double shift = 0.0;  // every 97th edge made vertical, the rest moved left to keep x monotone
+  for (std::size_t i = 1; i < chain.size(); ++i) {
+    if (i % 97 == 0) shift = chain[i].x - chain[i - 1].x;  // chain[i] not yet moved
+    chain[i].x -= shift;
+  }
+  for (auto _ : state) {
+    scallop::ScallopHull result = scallop::scallopHull(chain, kRadius);
+    benchmark::DoNotOptimize(result.toolpath.data());
+    state.counters["exact_steps"] = static_cast<double>(result.stats.exactSteps);
   }
   state.SetItemsProcessed(state.iterations() * state.range(0));
 }
@@ -393,6 +410,7 @@ BENCHMARK_CAPTURE(BM_OrientCircle, paper2_100k_full, "paper-2", 4e-7, false)->It
 BENCHMARK(BM_MedialAxis)->Arg(1000)->Arg(10000)->Arg(100000)->Unit(benchmark::kMillisecond);
 
 BENCHMARK(BM_ScallopHull)->RangeMultiplier(2)->Range(1 << 10, 1 << 23)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ScallopHullWalls)->Arg(1 << 14)->Arg(1 << 20)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ScallopHullExact)->Arg(1 << 10)->Arg(1 << 14)->Arg(1 << 20)->Arg(1 << 23)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_UpperHull)->RangeMultiplier(2)->Range(1 << 10, 1 << 23)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_HullOutputCopy)->Arg(1 << 10)->Arg(1 << 14)->Arg(1 << 20)->Arg(1 << 23)->Unit(benchmark::kMillisecond);

@@ -539,17 +539,16 @@ class UnitPass {
 
   std::vector<StackEntry> run(HullStats& stats) {
     std::vector<StackEntry> capsules;
-    capsules.reserve(std::min<std::size_t>(chain_.size(), std::size_t{1} << 20));
     capsules_ = &capsules;
     stats_ = &stats;
     units_.reserve(std::min<std::size_t>(chain_.size(), std::size_t{1} << 20));
-    units_.push_back({kBottom, 0.0, 0.0, 0.0, 1.0, 0, false});
-    units_.push_back({-1, v_[0].x - r_, v_[0].z, 0.0, 1.0, 0, false});
+    units_.push_back({kBottom, 0.0, 0.0, 0.0, 1.0});
+    units_.push_back({-1, v_[0].x - r_, v_[0].z, 0.0, 1.0});
     for (long k = 0; k + 1 < n_; ++k) {
       if (units_.size() > 1 && addUnit(k)) continue;
       handToExactPass(k);
     }
-    if (units_.size() > 1) finalize(units_.back(), -1, true);
+    writeCapsules();
     return capsules;
   }
 
@@ -560,13 +559,12 @@ class UnitPass {
     long edge;      // -1: the arc around v_0; e >= 0: edge e's offset line, then the arc around v_{e+1}
     double x, z;    // where the unit takes over the envelope
     double nx, nz;  // edge e's upward unit normal (makeCapsule's)
-    std::size_t capsuleStart;  // where its capsule entries begin in the capsule stack
-    bool continues;            // its line continues the capsule entry the unit before wrote
-    // Whether its arc went to the next edge's capsule (which took over at the convex vertex),
-    // and that edge's normal.
-    bool handed = false;
-    double handedNx = 0.0;
-    double handedNz = 0.0;
+    bool afterArc = false;  // the unit below ends its piece here on its arc (else on its line)
+    bool handed = false;    // its arc went to the next edge's capsule (at a convex vertex)
+  };
+
+  struct UnitNormal {
+    double nx, nz;
   };
 
   [[nodiscard]] double lineEndX(const Unit& u) const { return v_[u.edge + 1].x + r_ * u.nx; }
@@ -589,47 +587,63 @@ class UnitPass {
     return arcTop(c, r_, x);
   }
 
-  // Writes unit u's capsule entries, its piece ending at the next unit (edge nextEdge, or -1
-  // at the end of the chain) on u's arc (endsOnArc) or on its line. Sets continues_ for the
-  // next unit.
-  void finalize(const Unit& u, long nextEdge, bool endsOnArc) {
+  // The upward unit normal of edge e, as makeCapsule computes it.
+  [[nodiscard]] UnitNormal normalOf(long e) const {
+    const double dx = v_[e + 1].x - v_[e].x;
+    const double dz = v_[e + 1].z - v_[e].z;
+    const double length = std::sqrt(dx * dx + dz * dz);
+    return {-dz / length, dx / length};
+  }
+
+  // Appends the capsule entries of the units above the bottom, each unit's piece ending where
+  // the next one starts (on its arc or its line: the next unit's afterArc) and the last one's
+  // at its end, then leaves no units. Each unit is written once, so all the writing is O(n).
+  void writeCapsules() {
     std::vector<StackEntry>& capsules = *capsules_;
-    truncate(capsules, u.capsuleStart);
-    if (u.edge < 0) {
-      // The arc around v_0 starts capsule 0; the next unit continues it if it is unit 0.
-      capsules.push_back({0, u.x, u.z, firstNx_, firstNz_, false});
-      continues_ = nextEdge == 0;
-      return;
-    }
-    const std::size_t edge = static_cast<std::size_t>(u.edge);
-    const double s1 = lineEndX(u);
-    const bool hasLine = u.x < s1;
-    if (hasLine && !u.continues) capsules.push_back({edge, u.x, u.z, u.nx, u.nz, false});
-    continues_ = false;
-    if (endsOnArc && u.handed) {
-      // The arc around v_{e+1} is the next capsule's, from where the line ends.
-      if (hasLine) {
-        capsules.push_back({edge + 1, s1, v_[u.edge + 1].z + r_ * u.nz, u.handedNx, u.handedNz, false});
-      } else {
-        capsules.push_back({edge + 1, u.x, u.z, u.handedNx, u.handedNz, false});
+    // One entry a unit, two where its arc went to the next capsule (a convex vertex); grown
+    // geometrically, as a hand-off to the exact pass writes a few units at a time.
+    const std::size_t needed = capsules.size() + units_.size() + units_.size() / 4;
+    if (needed > capsules.capacity()) capsules.reserve(std::max(needed, 2 * capsules.capacity()));
+    bool continues = false;  // the unit's line continues the entry the unit below wrote
+    for (std::size_t i = 1; i < units_.size(); ++i) {
+      const Unit& u = units_[i];
+      const bool last = i + 1 == units_.size();
+      const long nextEdge = last ? -1 : units_[i + 1].edge;
+      const bool endsOnArc = last || units_[i + 1].afterArc;
+      if (u.edge < 0) {
+        // The arc around v_0 starts capsule 0; the next unit continues it if it is unit 0.
+        capsules.push_back({0, u.x, u.z, firstNx_, firstNz_, false});
+        continues = nextEdge == 0;
+        continue;
       }
-      continues_ = nextEdge == u.edge + 1;
-    } else if (!hasLine && !u.continues) {
-      capsules.push_back({edge, u.x, u.z, u.nx, u.nz, false});
+      const std::size_t edge = static_cast<std::size_t>(u.edge);
+      const double s1 = lineEndX(u);
+      const bool hasLine = u.x < s1;
+      if (hasLine && !continues) capsules.push_back({edge, u.x, u.z, u.nx, u.nz, false});
+      const bool wasContinued = continues;
+      continues = false;
+      if (endsOnArc && u.handed) {
+        // The arc around v_{e+1} is the next capsule's, from where the line ends.
+        const UnitNormal next = normalOf(u.edge + 1);
+        if (hasLine) {
+          capsules.push_back({edge + 1, s1, v_[u.edge + 1].z + r_ * u.nz, next.nx, next.nz, false});
+        } else {
+          capsules.push_back({edge + 1, u.x, u.z, next.nx, next.nz, false});
+        }
+        continues = nextEdge == u.edge + 1;
+      } else if (!hasLine && !wasContinued) {
+        capsules.push_back({edge, u.x, u.z, u.nx, u.nz, false});
+      }
     }
+    units_.clear();
   }
 
   // Pops `pops` units, then pushes unit k at (x, z), ending the piece of the unit below on
   // its arc or its line.
-  struct UnitNormal {
-    double nx, nz;
-  };
-
   void commit(std::size_t pops, long k, double x, double z, const UnitNormal& K, bool topEndsOnArc) {
     truncate(units_, units_.size() - pops);
     stats_->pops += pops;
-    finalize(units_.back(), k, topEndsOnArc);
-    units_.push_back({k, x, z, K.nx, K.nz, capsules_->size(), continues_});
+    units_.push_back({k, x, z, K.nx, K.nz, topEndsOnArc, false});
     ++stats_->pushes;
   }
 
@@ -637,12 +651,12 @@ class UnitPass {
   void handToExactPass(long k) {
     // The stack as the exact pass has it after edge k-1 (before edge 0 it is empty: the arc
     // around v_0 is capsule 0's, which exactStep adds).
-    if (units_.size() > 1 && units_.back().edge >= 0) finalize(units_.back(), -1, true);
-    units_.clear();
+    if (units_.size() == 2 && units_[1].edge < 0) units_.clear();
+    writeCapsules();
     const std::size_t edge = static_cast<std::size_t>(k);
     exactStep(chain_, edge, r_, tau_, band_, verticalRun_, *capsules_, *stats_);
     ++stats_->exactSteps;
-    const StackEntry& top = capsules_->back();
+    const StackEntry top = capsules_->back();
     if (top.edge != edge || top.jump) return;
     const Capsule K = makeCapsule(v_[k], v_[k + 1], r_, verticalRun_);
     if (K.vertical || stretchOf(K, {top.x, top.z}) == Stretch::arcA) return;
@@ -650,8 +664,10 @@ class UnitPass {
       firstNx_ = K.nx;
       firstNz_ = K.nz;
     }
-    units_.push_back({kBottom, 0.0, 0.0, 0.0, 1.0, capsules_->size() - 1, false});
-    units_.push_back({k, top.x, top.z, K.nx, K.nz, capsules_->size() - 1, false});
+    // Unit k takes that capsule's place (writeCapsules writes it back as it was).
+    capsules_->pop_back();
+    units_.push_back({kBottom, 0.0, 0.0, 0.0, 1.0});
+    units_.push_back({k, top.x, top.z, K.nx, K.nz});
   }
 
   // Adds unit k when the filters decide every step; false (nothing changed) otherwise.
@@ -709,10 +725,7 @@ class UnitPass {
         // Convex at v_k: the new line leaves the arc around v_k at its tangent point, and the
         // arc is capsule k's.
         if (!(s0 > t.x)) return false;
-        Unit& handing = units_.back();
-        handing.handed = true;
-        handing.handedNx = K.nx;
-        handing.handedNz = K.nz;
+        units_.back().handed = true;
         commit(0, k, s0, a.z + r_ * K.nz, K, true);
         return true;
       }
@@ -805,7 +818,6 @@ class UnitPass {
   double verticalRun_;
   double firstNx_ = 0.0;
   double firstNz_ = 1.0;
-  bool continues_ = false;
   std::vector<Unit> units_;
   std::vector<StackEntry>* capsules_ = nullptr;
   HullStats* stats_ = nullptr;
