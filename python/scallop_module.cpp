@@ -47,6 +47,7 @@
 #include "scallop/jobs/mesh_plan.hpp"
 #include "scallop/paths/chain.hpp"
 #include "scallop/io/chain_io.hpp"
+#include "scallop/io/file_output.hpp"
 #include "scallop/paths/cut_simulation.hpp"
 #include "scallop/error.hpp"
 #include "scallop/io/gcode.hpp"
@@ -75,6 +76,13 @@ using scallop::Vec3;
 
 // C-contiguous float64, converted from any array-like (lists, integer arrays).
 using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+// Files a job would write, name -> contents, for Python (nothing is written to disk).
+py::dict filesDict(const std::vector<scallop::OutputFile>& files) {
+  py::dict out;
+  for (const scallop::OutputFile& file : files) out[py::str(file.path)] = py::str(file.content);
+  return out;
+}
 
 constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
 
@@ -1166,12 +1174,7 @@ PYBIND11_MODULE(scallop, m) {
           py::return_value_policy::reference_internal, "The optimal slicing orientation N* the plan used.")
       .def(
           "files",
-          [](const Plan& p) {
-            py::dict out;
-            for (const scallop::OutputFile& file : scallop::planFiles(p.surface, p.result))
-              out[py::str(file.path)] = py::str(file.content);
-            return out;
-          },
+          [](const Plan& p) { return filesDict(scallop::planFiles(p.surface, p.result)); },
           "The files `scallop plan` writes, name -> contents: the G-code, report.json, verify.svg, paths.svg, "
           "paths-plan.svg, gauss-map.svg, stereographic.svg. Nothing is written to disk.");
 
@@ -1433,12 +1436,7 @@ PYBIND11_MODULE(scallop, m) {
           "Rounds of rest passes added where the simulated cut left more than H.")
       .def(
           "files",
-          [](const MeshPlan& p) {
-            py::dict out;
-            for (const scallop::OutputFile& file : scallop::meshPlanFiles(p.result))
-              out[py::str(file.path)] = py::str(file.content);
-            return out;
-          },
+          [](const MeshPlan& p) { return filesDict(scallop::meshPlanFiles(p.result)); },
           "The files `scallop plan PART.stl` writes, name -> contents: the G-code, report.json, verify.svg. "
           "Nothing is written to disk.");
 

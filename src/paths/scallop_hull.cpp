@@ -97,13 +97,24 @@ Capsule capsuleWithNormal(const Point2& a, const Point2& b, double r, double nx,
 // An edge whose run dx is at most `verticalRun` is taken as vertical: moving its end by dx
 // moves the envelope by at most dx, well inside the tolerance, while on a line a few ulps
 // wide x no longer tells where along it a point is (see Stretch).
-Capsule makeCapsule(const Point2& a, const Point2& b, double r, double verticalRun) {
+struct UnitNormal {
+  double nx, nz;
+};
+
+// The upward unit normal of the (not vertical) edge a -> b: the one formula both passes use,
+// so that their capsules agree bit for bit.
+UnitNormal upwardNormal(const Point2& a, const Point2& b) {
   const double dx = b.x - a.x;
   const double dz = b.z - a.z;
-  if (!(dx > verticalRun)) return capsuleWithNormal(a, b, r, 0.0, 0.0);
   double length = std::sqrt(dx * dx + dz * dz);
   if (!(length > 0.0) || !std::isfinite(length)) length = std::hypot(dx, dz);
-  return capsuleWithNormal(a, b, r, -dz / length, dx / length);
+  return {-dz / length, dx / length};
+}
+
+Capsule makeCapsule(const Point2& a, const Point2& b, double r, double verticalRun) {
+  if (!(b.x - a.x > verticalRun)) return capsuleWithNormal(a, b, r, 0.0, 0.0);
+  const UnitNormal n = upwardNormal(a, b);
+  return capsuleWithNormal(a, b, r, n.nx, n.nz);
 }
 
 // |(u, w)|^2 - r^2, written as (|u| - r)(|u| + r) + w^2 with |u| the larger component: no
@@ -466,6 +477,21 @@ std::optional<Point2> quickCrossing(const Capsule& t, const Capsule& k, double l
   return std::nullopt;
 }
 
+// The slope-slope hand-over at a concave vertex shared by T (ending there) and K (starting
+// there), Figure 6a: the offset lines meet at v + r (n_T + n_K) / (1 + n_T . n_K), the centre
+// at distance r from both lines. It is the hand-over if it lies on both offset lines' segments
+// (tested by projection, which a near-vertical line's x range cannot do) and not left of
+// `from`, where T's piece starts; otherwise nothing.
+std::optional<Point2> slopeSlopeHandOver(const Capsule& t, const Capsule& k, double from) {
+  const double denom = 1.0 + t.nx * k.nx + t.nz * k.nz;
+  if (!(denom > 1e-8)) return std::nullopt;
+  const Point2 q{t.b.x + t.r * (t.nx + k.nx) / denom, t.b.z + t.r * (t.nz + k.nz) / denom};
+  const double tT = projectOnLine(t, q);
+  const double tK = projectOnLine(k, q);
+  if (q.x >= from && tT >= 0.0 && tT <= 1.0 && tK >= 0.0 && tK <= 1.0) return q;
+  return std::nullopt;
+}
+
 struct StackEntry {
   std::size_t edge = 0;
   double x = 0.0;   // where this edge's capsule takes over the envelope
@@ -525,17 +551,10 @@ void exactStep(std::span<const Point2> chain, std::size_t k, double r, double ta
 // little to the right of a piece's start, which can land where two capsules share a vertex
 // arc, past a line piece shorter than that step); tests/paths/scallop_hull_test.cpp compares
 // the two bit for bit and, where they differ, within the tolerance.
-// Drops the elements from `size` on (no growth: cheaper than resize on the hot path).
-template <typename T>
-void truncate(std::vector<T>& v, std::size_t size) {
-  v.erase(v.begin() + static_cast<std::ptrdiff_t>(size), v.end());
-}
-
 class UnitPass {
  public:
   UnitPass(std::span<const Point2> chain, double r, double tau, double band, double verticalRun)
-      : chain_(chain), v_(chain.data()), n_(static_cast<long>(chain.size())), r_(r), tau_(tau),
-        band_(band), verticalRun_(verticalRun) {}
+      : chain_(chain), v_(chain.data()), r_(r), tau_(tau), band_(band), verticalRun_(verticalRun) {}
 
   std::vector<StackEntry> run(HullStats& stats) {
     std::vector<StackEntry> capsules;
@@ -544,7 +563,7 @@ class UnitPass {
     units_.reserve(std::min<std::size_t>(chain_.size(), std::size_t{1} << 20));
     units_.push_back({kBottom, 0.0, 0.0, 0.0, 1.0});
     units_.push_back({-1, v_[0].x - r_, v_[0].z, 0.0, 1.0});
-    for (long k = 0; k + 1 < n_; ++k) {
+    for (long k = 0; k + 1 < static_cast<long>(chain_.size()); ++k) {
       if (units_.size() > 1 && addUnit(k)) continue;
       handToExactPass(k);
     }
@@ -561,10 +580,6 @@ class UnitPass {
     double nx, nz;  // edge e's upward unit normal (makeCapsule's)
     bool afterArc = false;  // the unit below ends its piece here on its arc (else on its line)
     bool handed = false;    // its arc went to the next edge's capsule (at a convex vertex)
-  };
-
-  struct UnitNormal {
-    double nx, nz;
   };
 
   [[nodiscard]] double lineEndX(const Unit& u) const { return v_[u.edge + 1].x + r_ * u.nx; }
@@ -587,14 +602,6 @@ class UnitPass {
     return arcTop(c, r_, x);
   }
 
-  // The upward unit normal of edge e, as makeCapsule computes it.
-  [[nodiscard]] UnitNormal normalOf(long e) const {
-    const double dx = v_[e + 1].x - v_[e].x;
-    const double dz = v_[e + 1].z - v_[e].z;
-    const double length = std::sqrt(dx * dx + dz * dz);
-    return {-dz / length, dx / length};
-  }
-
   // Appends the capsule entries of the units above the bottom, each unit's piece ending where
   // the next one starts (on its arc or its line: the next unit's afterArc) and the last one's
   // at its end, then leaves no units. Each unit is written once, so all the writing is O(n).
@@ -611,8 +618,10 @@ class UnitPass {
       const long nextEdge = last ? -1 : units_[i + 1].edge;
       const bool endsOnArc = last || units_[i + 1].afterArc;
       if (u.edge < 0) {
-        // The arc around v_0 starts capsule 0; the next unit continues it if it is unit 0.
-        capsules.push_back({0, u.x, u.z, firstNx_, firstNz_, false});
+        // The arc around v_0 starts capsule 0 (edge 0 is not vertical: the unit pass took
+        // it); the next unit continues it if it is unit 0.
+        const UnitNormal first = upwardNormal(v_[0], v_[1]);
+        capsules.push_back({0, u.x, u.z, first.nx, first.nz, false});
         continues = nextEdge == 0;
         continue;
       }
@@ -624,7 +633,7 @@ class UnitPass {
       continues = false;
       if (endsOnArc && u.handed) {
         // The arc around v_{e+1} is the next capsule's, from where the line ends.
-        const UnitNormal next = normalOf(u.edge + 1);
+        const UnitNormal next = upwardNormal(v_[u.edge + 1], v_[u.edge + 2]);
         if (hasLine) {
           capsules.push_back({edge + 1, s1, v_[u.edge + 1].z + r_ * u.nz, next.nx, next.nz, false});
         } else {
@@ -641,7 +650,7 @@ class UnitPass {
   // Pops `pops` units, then pushes unit k at (x, z), ending the piece of the unit below on
   // its arc or its line.
   void commit(std::size_t pops, long k, double x, double z, const UnitNormal& K, bool topEndsOnArc) {
-    truncate(units_, units_.size() - pops);
+    units_.erase(units_.end() - static_cast<std::ptrdiff_t>(pops), units_.end());
     stats_->pops += pops;
     units_.push_back({k, x, z, K.nx, K.nz, topEndsOnArc, false});
     ++stats_->pushes;
@@ -660,10 +669,6 @@ class UnitPass {
     if (top.edge != edge || top.jump) return;
     const Capsule K = makeCapsule(v_[k], v_[k + 1], r_, verticalRun_);
     if (K.vertical || stretchOf(K, {top.x, top.z}) == Stretch::arcA) return;
-    if (k == 0) {
-      firstNx_ = K.nx;
-      firstNz_ = K.nz;
-    }
     // Unit k takes that capsule's place (writeCapsules writes it back as it was).
     capsules_->pop_back();
     units_.push_back({kBottom, 0.0, 0.0, 0.0, 1.0});
@@ -674,17 +679,8 @@ class UnitPass {
   bool addUnit(long k) {
     const Point2& a = v_[k];
     const Point2& b = v_[k + 1];
-    // makeCapsule's normal and offset line, computed the same way, without the rest of it.
-    const double dx = b.x - a.x;
-    const double dz = b.z - a.z;
-    if (!(dx > verticalRun_)) return false;  // vertical (makeCapsule's test)
-    const double length = std::sqrt(dx * dx + dz * dz);
-    if (!(length > 0.0) || !std::isfinite(length)) return false;
-    const UnitNormal K{-dz / length, dx / length};
-    if (k == 0) {
-      firstNx_ = K.nx;
-      firstNz_ = K.nz;
-    }
+    if (!(b.x - a.x > verticalRun_)) return false;  // vertical (makeCapsule's test)
+    const UnitNormal K = upwardNormal(a, b);  // makeCapsule's, without the rest of the capsule
     const double s0 = a.x + r_ * K.nx;
     const double s1 = b.x + r_ * K.nx;
 
@@ -729,17 +725,11 @@ class UnitPass {
         commit(0, k, s0, a.z + r_ * K.nz, K, true);
         return true;
       }
-      // Concave at v_k (slope-slope, Figure 6a): the exact pass's closed form and tests.
-      const Capsule T = capsuleWithNormal(p, a, r_, t.nx, t.nz);
-      const double denom = 1.0 + T.nx * K.nx + T.nz * K.nz;
-      if (denom > 1e-8) {
-        const Point2 q{T.b.x + r_ * (T.nx + K.nx) / denom, T.b.z + r_ * (T.nz + K.nz) / denom};
-        const double tT = projectOnLine(T, q);
-        const double tK = projectOnLine(capsuleWithNormal(a, b, r_, K.nx, K.nz), q);
-        if (q.x >= t.x && tT >= 0.0 && tT <= 1.0 && tK >= 0.0 && tK <= 1.0) {
-          commit(0, k, q.x, q.z, K, false);
-          return true;
-        }
+      // Concave at v_k: the exact pass's slope-slope closed form.
+      if (const auto q = slopeSlopeHandOver(capsuleWithNormal(p, a, r_, t.nx, t.nz),
+                                            capsuleWithNormal(a, b, r_, K.nx, K.nz), t.x)) {
+        commit(0, k, q->x, q->z, K, false);
+        return true;
       }
       pieceEnd = a.x + r_;  // otherwise the crossing below, over the top's whole piece
     }
@@ -811,13 +801,10 @@ class UnitPass {
 
   std::span<const Point2> chain_;
   const Point2* v_;
-  long n_;
   double r_;
   double tau_;
   double band_;
   double verticalRun_;
-  double firstNx_ = 0.0;
-  double firstNz_ = 1.0;
   std::vector<Unit> units_;
   std::vector<StackEntry>* capsules_ = nullptr;
   HullStats* stats_ = nullptr;
@@ -1061,8 +1048,6 @@ class OutputBuilder {
   Point2 contact_;  // current contact point on the chain
 };
 
-// The exact pass: capsules added left to right on a stack (scallop_hull.hpp, Method), every
-// case decided, with vertical edges and ties within rounding.
 // One step of the exact pass: capsule k added to the stack (scallop_hull.hpp, Method), every
 // case decided, with vertical edges and ties within rounding.
 void exactStep(std::span<const Point2> chain, std::size_t k, double r, double tau, double band,
@@ -1115,19 +1100,10 @@ void exactStep(std::span<const Point2> chain, std::size_t k, double r, double ta
       }
       return;
     }
-    // Concave at v (slope-slope, Figure 6a): the offset lines meet at
-    // v + r (n_T + n_K) / (1 + n_T . n_K), the centre at distance r from both lines.
-    // It is the hand-over if it lies on both offset lines' segments (tested by projection,
-    // which a near-vertical line's x range cannot do).
-    const double denom = 1.0 + T.nx * K.nx + T.nz * K.nz;
-    if (denom > 1e-8) {
-      const Point2 q{T.b.x + r * (T.nx + K.nx) / denom, T.b.z + r * (T.nz + K.nz) / denom};
-      const double tT = projectOnLine(T, q);
-      const double tK = projectOnLine(K, q);
-      if (q.x >= lo && tT >= 0.0 && tT <= 1.0 && tK >= 0.0 && tK <= 1.0) {
-        push(k, q.x, q.z, K);
-        return;
-      }
+    // Concave at v: the slope-slope hand-over, when it lies on both offset lines.
+    if (const auto q = slopeSlopeHandOver(T, K, lo)) {
+      push(k, q->x, q->z, K);
+      return;
     }
   } else if (!isBelowTop(K, hi, T.upperEndAtRight().z)) {
     // K is below T where T ends: it takes over only beyond T's reach (the ball drops
