@@ -1033,9 +1033,11 @@ PYBIND11_MODULE(scallop, m) {
             out["pushes"] = h.hull.stats.pushes;
             out["pops"] = h.hull.stats.pops;
             out["comparisons"] = h.hull.stats.comparisons;
+            out["exact_steps"] = h.hull.stats.exactSteps;
             return out;
           },
-          "The linear-time counters: edge pushes and pops on the hull stack, capsule comparisons.")
+          "The linear-time counters: edge pushes and pops on the hull stack, capsule comparisons, and the "
+          "edges the exact pass added (vertical edges, ties the filtered pass leaves to it).")
       .def(
           "to_json", [](const Hull& h) { return scallop::hullToJson(h.hull, h.vertices); },
           "The JSON form of `scallop hull --json` (hull_json.hpp).");

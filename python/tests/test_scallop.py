@@ -206,6 +206,18 @@ class HullTest(unittest.TestCase):
         np.testing.assert_allclose(b.toolpath[:, :4], a.toolpath[:, :4] + np.tile(shift, 2), atol=1e-9)
         self.assertAlmostEqual(a.length, b.length, delta=1e-9)
 
+    def test_stats_count_the_exact_steps(self):
+        # A walk without vertical edges: the filtered pass decides every edge. A vertical edge
+        # goes to the exact pass; the counters stay linear.
+        walk = [[0.0, 0.0], [1.0, 2.0], [2.0, 0.5], [3.0, 3.0], [4.0, 1.0]]
+        plain = scallop.hull(walk, 0.5).stats
+        self.assertEqual(plain["exact_steps"], 0)
+        self.assertEqual(plain["pushes"], len(walk) - 1)
+        wall = scallop.hull([[0.0, 0.0], [1.0, 2.0], [1.0, -1.0], [3.0, 3.0], [4.0, 1.0]], 0.5).stats
+        self.assertGreaterEqual(wall["exact_steps"], 1)
+        self.assertLessEqual(wall["pushes"], 4)
+        self.assertLessEqual(wall["pops"], wall["pushes"])
+
     def test_infinite_radius_is_the_upper_convex_hull(self):
         hull = scallop.hull([[0.0, 0.0], [1.0, -1.0], [2.0, 0.0]], math.inf)
         self.assertEqual(len(hull.toolpath), 0)
