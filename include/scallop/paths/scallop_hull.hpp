@@ -100,9 +100,9 @@ struct HullStats {
   std::uint64_t exactSteps = 0;  ///< edges the exact pass added (all of them with HullMethod::exact)
 };
 
-/// Which pass builds the stack (see Method above).
+/// Which pass builds the stack for a finite radius (see Method above; r = infinity has one).
 enum class HullMethod {
-  automatic,  ///< the filtered pass, the exact pass where it gives up (the same result)
+  automatic,  ///< the filtered pass, the exact pass for the edges it leaves (the default)
   exact,      ///< the exact pass alone: for comparisons and tests
 };
 
