@@ -23,6 +23,12 @@
 //                             side by side (on a 3 in grid): queries per second as the
 //                             surface grows (the hierarchy of patch boxes: about flat in N;
 //                             a scan of every patch's root cell would fall as 1 / N)
+//   BM_ClearanceLongPatch/<S>/<cut>  SurfaceDistance::segmentClearance of 4,096 segments
+//                             (fixed seed) 0.05 in long, tangent to the offset at R = 1/4 in
+//                             of paper-1's patch stretched S times along x, clearance R - 1e-4:
+//                             the drop envelope's proofs. cut 1: long patches cut into pieces
+//                             (gouge.hpp's Pieces, the default), 0: searched whole, in the
+//                             same run; proofs per second and cells per proof
 
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>
@@ -35,6 +41,7 @@
 #include <string>
 #include <vector>
 
+#include "scallop/geometry/bezier.hpp"
 #include "scallop/paths/contour.hpp"
 #include "scallop/paths/envelope.hpp"
 #include "scallop/io/gcode.hpp"
@@ -237,6 +244,48 @@ void BM_DistanceManyPatches(benchmark::State& state) {
   state.SetLabel(fmt::format("{} patches", copies));
 }
 
+void BM_ClearanceLongPatch(benchmark::State& state) {
+  const double stretch = static_cast<double>(state.range(0));
+  scallop::Surface surface = scallop::exampleSurface("paper-1");
+  for (scallop::Vec3& p : surface.patches.front().control) p.x *= stretch;
+  scallop::DistanceOptions options;
+  options.cutLongPatches = state.range(1) == 1;
+  const scallop::SurfaceDistance distance(surface, options);
+  const scallop::BezierPatch& patch = surface.patches.front();
+  std::mt19937_64 random(15);
+  std::uniform_real_distribution<double> unit(0.05, 0.95), turn(0.0, 6.283185307179586);
+  struct Query {
+    scallop::Vec3 a, b;
+  };
+  std::vector<Query> queries(4096);
+  for (Query& q : queries) {
+    const double u = unit(random), v = unit(random);
+    const scallop::Vec3 n = scallop::unitNormal(patch, u, v);
+    const scallop::Vec3 centre = scallop::point(patch, u, v) + kToolRadius * n;
+    // A direction in the tangent plane: any vector made orthogonal to n.
+    const double a = turn(random);
+    scallop::Vec3 t{std::cos(a), std::sin(a), 0.0};
+    t = t - scallop::dot(t, n) * n;
+    t = (0.025 / scallop::norm(t)) * t;
+    q = {centre - t, centre + t};
+  }
+  std::size_t cells = 0, proven = 0;
+  for (auto _ : state) {
+    cells = proven = 0;
+    for (const Query& q : queries) {
+      const scallop::SegmentClearance result = distance.segmentClearance(q.a, q.b, kToolRadius - 1e-4);
+      cells += result.cells;
+      proven += result.verdict == scallop::Clearance::proven ? 1 : 0;
+    }
+  }
+  state.counters["proven"] = static_cast<double>(proven);
+  state.counters["cells_per_query"] = static_cast<double>(cells) / static_cast<double>(queries.size());
+  state.counters["queries_per_s"] =
+      benchmark::Counter(static_cast<double>(queries.size()), benchmark::Counter::kIsIterationInvariantRate);
+  state.SetLabel(fmt::format("stretched {}x, {}", state.range(0), state.range(1) == 1 ? "cut" : "whole"));
+}
+
+BENCHMARK(BM_ClearanceLongPatch)->ArgsProduct({{1, 10, 100}, {0, 1}})->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_DistanceManyPatches)->Arg(1)->Arg(16)->Arg(256)->Arg(4096)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_DropCutter)->Args({1, 1})->Args({1, 0})->Args({2, 1})->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LinkContour)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);

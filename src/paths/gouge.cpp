@@ -62,7 +62,20 @@ struct PatchTree {
   // missed the cache on every cell (a quarter of a trimmed face's plan). Null: untrimmed.
   std::shared_ptr<std::atomic<std::uint8_t>[]> places;
   std::vector<std::size_t> placeOffset;
+  // The piece of the surface's patch `original` this tree covers (SurfaceDistance cuts long
+  // thin patches, see the contract's Pieces): its net reparametrised to [0, 1]^2 (`patch`),
+  // and where it lies in the original's parameters, [u0, u0 + du] x [v0, v0 + dv], du and dv
+  // powers of 2 (so the map is exact). `splits` halvings made it; the rounding allowance
+  // counts them as cell depth, and `scale` and `weightRatio` are the original patch's.
+  BezierPatch patch;
+  std::uint32_t original = 0;
+  double u0 = 0.0, du = 1.0, v0 = 0.0, dv = 1.0;
+  int splits = 0;
 };
+
+// A piece's parameters in its original patch's.
+double originalU(const PatchTree& tree, double s) { return tree.u0 + s * tree.du; }
+double originalV(const PatchTree& tree, double t) { return tree.v0 + t * tree.dv; }
 
 // A node of the hierarchy of the patches' root boxes: a leaf holds `count` patches
 // (nodePatches_[first, first + count)), an inner node two children. Its rounding allowance
@@ -698,7 +711,7 @@ double allowanceCoefficient(const PatchTree& tree, int depth) {
   // their errors, each of the polynomial net's order relative to w_max |p|_max and w_max,
   // are divided by w >= w_min, so at most 2 w_max / w_min times the polynomial allowance.
   const double quotient = tree.rational ? 2.0 * tree.weightRatio + 1.0 : 1.0;
-  return quotient * (3.0 * (tree.degreeU + tree.degreeV) * (depth + 1) + 16.0) * kUnitRoundoff;
+  return quotient * (3.0 * (tree.degreeU + tree.degreeV) * (depth + tree.splits + 1) + 16.0) * kUnitRoundoff;
 }
 
 double cellAllowance(const PatchTree& tree, int depth, double queryScale) {
@@ -997,6 +1010,84 @@ PatchTree buildTree(const BezierPatch& patch, int depth) {
   return tree;
 }
 
+// Long thin patches cut into pieces (see the contract's Pieces).
+struct CutPiece {
+  BezierPatch patch;
+  std::uint32_t original = 0;
+  double u0 = 0.0, du = 1.0, v0 = 0.0, dv = 1.0;
+  int splits = 0;
+};
+
+// The longest of a net's control polygons along u (alongU) or v: a bound on the length of
+// the patch's parameter lines that way.
+double longestPolygon(const BezierPatch& patch, bool alongU) {
+  const int m = patch.degreeU, n = patch.degreeV;
+  double longest = 0.0;
+  for (int line = 0; line <= (alongU ? n : m); ++line) {
+    double length = 0.0;
+    for (int i = 0; i < (alongU ? m : n); ++i)
+      length += alongU ? norm(patch.at(i + 1, line) - patch.at(i, line)) : norm(patch.at(line, i + 1) - patch.at(line, i));
+    longest = std::max(longest, length);
+  }
+  return longest;
+}
+
+std::vector<CutPiece> cutLongPatches(const Surface& surface, bool cut) {
+  // Halvings wanted per patch in u and v: the longer way halved until it is at most twice the
+  // other (an aspect of 2^kMaxPieceHalvings at most is evened out).
+  std::vector<std::pair<int, int>> wanted;
+  wanted.reserve(surface.patches.size());
+  for (const BezierPatch& patch : surface.patches) {
+    double lu = longestPolygon(patch, true), lv = longestPolygon(patch, false);
+    int ku = 0, kv = 0;
+    while (cut && ku < kMaxPieceHalvings && lu > 2.0 * lv) lu *= 0.5, ++ku;
+    while (cut && kv < kMaxPieceHalvings && lv > 2.0 * lu) lv *= 0.5, ++kv;
+    wanted.emplace_back(ku, kv);
+  }
+  // Within kPiecesBudget: every patch's halvings capped alike, the cap lowered until it fits.
+  int cap = kMaxPieceHalvings;
+  const auto piecesAt = [&](int c) {
+    std::size_t count = 0;
+    for (const auto& [ku, kv] : wanted) count += std::size_t{1} << (std::min(ku, c) + std::min(kv, c));
+    return count;
+  };
+  while (cap > 0 && piecesAt(cap) > std::max(kPiecesBudget, surface.patches.size())) --cap;
+  std::vector<CutPiece> pieces;
+  pieces.reserve(piecesAt(cap));
+  for (std::size_t i = 0; i < surface.patches.size(); ++i) {
+    const int ku = std::min(wanted[i].first, cap), kv = std::min(wanted[i].second, cap);
+    const std::size_t first = pieces.size();
+    pieces.push_back({surface.patches[i], static_cast<std::uint32_t>(i), 0.0, 1.0, 0.0, 1.0, 0});
+    // Halved at 1/2 (de Casteljau, as the cells are), u first: the pieces in u-major order.
+    for (int level = 0; level < ku + kv; ++level) {
+      const bool inU = level < ku;
+      const std::size_t end = pieces.size();
+      std::vector<CutPiece> halves;
+      halves.reserve(2 * (end - first));
+      for (std::size_t k = first; k < end; ++k) {
+        const CutPiece& piece = pieces[k];
+        auto [low, high] = inU ? subdivideU(piece.patch, 0.5) : subdivideV(piece.patch, 0.5);
+        CutPiece a = piece, b = piece;
+        a.patch = std::move(low);
+        b.patch = std::move(high);
+        if (inU) {
+          a.du = b.du = 0.5 * piece.du;
+          b.u0 = piece.u0 + a.du;
+        } else {
+          a.dv = b.dv = 0.5 * piece.dv;
+          b.v0 = piece.v0 + a.dv;
+        }
+        a.splits = b.splits = piece.splits + 1;
+        halves.push_back(std::move(a));
+        halves.push_back(std::move(b));
+      }
+      pieces.resize(first);
+      for (CutPiece& half : halves) pieces.push_back(std::move(half));
+    }
+  }
+  return pieces;
+}
+
 // Cells of trimmed patches classified, kept per thread across queries (keyed by the
 // SurfaceDistance's id, patch, depth and position): consecutive queries classify the same
 // cells, and classifying one halves the face's arcs down to its size. Emptied past 2^20.
@@ -1020,7 +1111,7 @@ struct TrimCellCache {
 bool classifyForTrim(const std::vector<PatchTrim>* trims, std::uint64_t id, const PatchTree& tree,
                      CellStore& store, Cell& cell) {
   if (cell.inFace) return true;
-  if (trims == nullptr || !(*trims)[cell.patch].trimmed()) {
+  if (trims == nullptr || !(*trims)[tree.original].trimmed()) {
     cell.inFace = true;  // all of an untrimmed patch is surface
     return true;
   }
@@ -1047,7 +1138,9 @@ bool classifyForTrim(const std::vector<PatchTrim>* trims, std::uint64_t id, cons
                     (TrimCellCache::kSlots - 1)];
     if (slot.id != id || slot.iu != iu || slot.iv != iv || slot.patch != cell.patch || slot.depth != cell.depth) {
       slot = {id, iu, iv, cell.patch, cell.depth,
-              classifyCell((*trims)[cell.patch], ParameterCell{cell.u0, cell.u0 + h, cell.v0, cell.v0 + h})};
+              classifyCell((*trims)[tree.original],
+                           ParameterCell{originalU(tree, cell.u0), originalU(tree, cell.u0 + h), originalV(tree, cell.v0),
+                                         originalV(tree, cell.v0 + h)})};
     }
     place = slot.place;
     const auto code = static_cast<std::uint8_t>(static_cast<std::uint8_t>(place) + 1);
@@ -1059,9 +1152,9 @@ bool classifyForTrim(const std::vector<PatchTrim>* trims, std::uint64_t id, cons
   return true;
 }
 
-// Whether a surface point of the patch counts (a trimmed patch's points outside its face do not).
-bool inFace(const std::vector<PatchTrim>* trims, std::size_t patch, double u, double v) {
-  return trims == nullptr || keepsPoint((*trims)[patch], u, v);
+// Whether a surface point of the piece counts (a trimmed patch's points outside its face do not).
+bool inFace(const std::vector<PatchTrim>* trims, const PatchTree& tree, double u, double v) {
+  return trims == nullptr || keepsPoint((*trims)[tree.original], originalU(tree, u), originalV(tree, v));
 }
 
 // The branch and bound of the contract (`scale`: the surface's, surfaceScale).
@@ -1133,20 +1226,20 @@ ClosestPoint search(const Surface& surface, double scale, const std::vector<Patc
       lowerBound = cell.lower;
       break;
     }
-    const BezierPatch& patch = surface.patches[cell.patch];
+    const BezierPatch& patch = trees[cell.patch].patch;
     const double h = cellSide(cell.depth);
     const double uc = cell.u0 + 0.5 * h;
     const double vc = cell.v0 + 0.5 * h;
     const Jet jet = jetAt(patch, uc, vc);
     if (norm(jet.r - p) < best.distance) {
       const Candidate polished = newton(patch, cell.patch, p, uc, vc, jet);
-      consider(jet.r, cell.patch, uc, vc, cell.inFace || inFace(trims, cell.patch, uc, vc));
+      consider(jet.r, cell.patch, uc, vc, cell.inFace || inFace(trims, trees[cell.patch], uc, vc));
       // Newton may leave the cell: its point is always tested.
       // A point of a cell known inside the face is in it (no winding to count).
       const bool inCell = polished.u >= cell.u0 && polished.u <= cell.u0 + h && polished.v >= cell.v0 &&
                           polished.v <= cell.v0 + h;
       consider(polished.point, cell.patch, polished.u, polished.v,
-               (cell.inFace && inCell) || inFace(trims, cell.patch, polished.u, polished.v));
+               (cell.inFace && inCell) || inFace(trims, trees[cell.patch], polished.u, polished.v));
     }
     if (cell.lower >= level()) {
       setAside = std::min(setAside, cell.lower);
@@ -1180,9 +1273,12 @@ ClosestPoint search(const Surface& surface, double scale, const std::vector<Patc
 
   ClosestPoint result;
   result.distance = best.distance;
-  result.patch = best.patch;
-  result.u = best.u;
-  result.v = best.v;
+  if (std::isfinite(best.distance)) {
+    const PatchTree& tree = trees[best.patch];
+    result.patch = tree.original;
+    result.u = originalU(tree, best.u);
+    result.v = originalV(tree, best.v);
+  }
   result.point = best.point;
   result.lowerBound = std::max(0.0, std::min({lowerBound, walk.waiting(), setAside, best.distance}));
   // Beside a trimming curve the bound is as fine as the cells there (see the contract).
@@ -1256,6 +1352,16 @@ SegmentClearance segmentSearch(const std::vector<PatchTree>& trees, const std::v
   heap.clear();
   store.prepare(id);
   SegmentClearance result;
+  // The nearest point's piece and parameters as the surface's patch and its parameters.
+  const auto inOriginalPatch = [&trees](SegmentClearance found) {
+    if (std::isfinite(found.distance)) {
+      const PatchTree& tree = trees[found.patch];
+      found.patch = tree.original;
+      found.u = originalU(tree, found.u);
+      found.v = originalV(tree, found.v);
+    }
+    return found;
+  };
   const QuerySegment segment(a, b);
   const double pScale = std::max(maxAbs(a), maxAbs(b));
   bool trimUnresolved = false;  // a cell on a trimming curve left at kTrimCellDepth within the clearance
@@ -1313,7 +1419,7 @@ SegmentClearance segmentSearch(const std::vector<PatchTree>& trees, const std::v
     const PatchTree& tree = trees[cell.patch];
     if (cell.depth >= kMaxCellDepth || result.cells >= maxCells) {
       result.verdict = Clearance::undecided;
-      return result;
+      return inOriginalPatch(result);
     }
     if (cell.depth >= kTrimCellDepth && !cell.inFace) {  // on a trimming curve (see search)
       trimUnresolved = true;  // on a trimming curve, as fine as the trim is followed: not proven
@@ -1322,7 +1428,7 @@ SegmentClearance segmentSearch(const std::vector<PatchTree>& trees, const std::v
     offerQuarters(cell, tree, store, offer);
   }
   result.verdict = violated ? Clearance::violated : trimUnresolved ? Clearance::undecided : Clearance::proven;
-  return result;
+  return inOriginalPatch(result);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -1489,21 +1595,38 @@ SurfaceDistance::SurfaceDistance(const Surface& surface, const DistanceOptions& 
   tolerance_ = options.tolerance > 0.0 ? options.tolerance : 1e-9 * scale_;
   // A surface collapsed to the origin has scale 0; any positive tolerance will do there.
   if (!(tolerance_ > 0.0)) tolerance_ = std::numeric_limits<double>::min();
+  std::vector<CutPiece> pieces = cutLongPatches(surface_, options.cutLongPatches);
   // The trees' depth, lowered for all patches alike to keep within kTreePointsBudget: deeper
   // cells are halved on demand as the same bits (the contract), so only speed depends on it.
   int depth = options.treeDepth;
   const auto pointsAt = [&](int levels) {
     std::size_t points = 0;
     const std::size_t cells = ((std::size_t{1} << (2 * (levels + 1))) - 1) / 3;
-    for (const BezierPatch& patch : surface_.patches) points += cells * patch.control.size() * (patch.rational() ? 2 : 1);
+    for (const CutPiece& piece : pieces)
+      points += cells * piece.patch.control.size() * (piece.patch.rational() ? 2 : 1);
     return points;
   };
   while (depth > 0 && pointsAt(depth) > kTreePointsBudget) --depth;
-  trees_.reserve(surface_.patches.size());
-  for (const BezierPatch& patch : surface_.patches) {
-    trees_.push_back(buildTree(patch, depth));
+  trees_.reserve(pieces.size());
+  for (CutPiece& piece : pieces) {
+    const BezierPatch& original = surface_.patches[piece.original];
+    trees_.push_back(buildTree(piece.patch, depth));
     PatchTree& tree = trees_.back();
-    if (surface_.trimmed() && surface_.trims[trees_.size() - 1].trimmed()) {
+    tree.original = piece.original;
+    tree.u0 = piece.u0;
+    tree.du = piece.du;
+    tree.v0 = piece.v0;
+    tree.dv = piece.dv;
+    tree.splits = piece.splits;
+    // The allowance is the original's: the piece's net carries the rounding of its splits.
+    tree.scale = 0.0;
+    for (const Vec3& c : original.control) tree.scale = std::max(tree.scale, maxAbs(c));
+    if (original.rational()) {
+      const auto [least, largest] = std::minmax_element(original.weights.begin(), original.weights.end());
+      tree.weightRatio = *largest / *least;
+    }
+    tree.patch = std::move(piece.patch);
+    if (surface_.trimmed() && surface_.trims[piece.original].trimmed()) {
       std::size_t cells = 0;
       for (int level = 0; level < tree.levels; ++level) {
         tree.placeOffset.push_back(cells);

@@ -111,6 +111,7 @@ struct TrimmedPaper {
     return {across(rng), across(rng), up(rng)};
   }
   double queryReach() const { return 3.5; }  // the query points' largest coordinate
+  int circleSamples() const { return 20000; }
 };
 
 // The arch: a cylinder of radius 2 about the y axis, r(s, t) = (2 cos a, 3 t, 2 sin a) for
@@ -183,6 +184,7 @@ struct TrimmedArch {
     return {across(rng), along(rng), up(rng)};
   }
   double queryReach() const { return 3.5; }
+  int circleSamples() const { return 20000; }
 };
 
 // The half-angle map against the angle read off the patch's points; the patch's membership
@@ -316,9 +318,12 @@ template <typename Case>
 void checkDistancesAreToTheFaceAlone(const Case& trimmed, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   const bool hole = trimmed.hole;
-  // 20,000 points of the circle, just inside the face (pulled in by 1e-13).
+  // Points of the circle (20,000, or as many as the case asks), just inside the face (pulled
+  // in by 1e-13): a start on the circle cannot slide along it, so their spacing bounds the
+  // reference's error where the face's nearest point is on the circle.
   std::vector<std::pair<double, double>> circle;
-  for (int i = 0; i < 20000; ++i) circle.push_back(trimmed.boundary(2.0 * std::numbers::pi * i / 20000.0, 1e-13));
+  const int samples = trimmed.circleSamples();
+  for (int i = 0; i < samples; ++i) circle.push_back(trimmed.boundary(2.0 * std::numbers::pi * i / samples, 1e-13));
   {
     const scallop::SurfaceDistance engine(trimmed.surface);
     Surface untrimmed = trimmed.surface;
@@ -351,6 +356,26 @@ void checkDistancesAreToTheFaceAlone(const Case& trimmed, std::uint64_t seed) {
 
 TEST(TrimmedSurface, DistancesAreToTheFaceAlone) {
   for (const bool hole : {false, true}) checkDistancesAreToTheFaceAlone(TrimmedPaper(hole), 1414);
+}
+
+// The same face on paper-1's patch stretched 20 times along x: SurfaceDistance searches it in
+// 16 pieces (gouge.hpp's Pieces), classified against the original patch's trim.
+struct TrimmedStrip : TrimmedPaper {
+  static constexpr double kStretch = 20.0;
+  explicit TrimmedStrip(bool withHole) : TrimmedPaper(withHole) {
+    for (Vec3& c : surface.patches[0].control) c.x *= kStretch;
+  }
+  Vec3 randomPoint(std::mt19937_64& rng) const {
+    std::uniform_real_distribution<double> alongX(-0.5 * kStretch, 3.5 * kStretch), across(-0.5, 3.5), up(-1.0, 2.5);
+    return {alongX(rng), across(rng), up(rng)};
+  }
+  double queryReach() const { return 3.5 * kStretch; }
+  // The circle is an ellipse 20 times as long: 10 times the samples keep their spacing within 2.
+  int circleSamples() const { return 200000; }
+};
+
+TEST(TrimmedSurface, DistancesOnALongThinTrimmedPatchAreToTheFaceAlone) {
+  for (const bool hole : {false, true}) checkDistancesAreToTheFaceAlone(TrimmedStrip(hole), 1416);
 }
 
 TEST(TrimmedSurface, DistancesToAHalfAngleTrimAreToTheFaceAlone) {

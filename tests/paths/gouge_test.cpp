@@ -470,6 +470,140 @@ TEST(SurfaceDistance, ManyPatchesAgreeWithEachPatchAlone) {
   EXPECT_GT(proven, 50);
 }
 
+// Long thin patches are searched in pieces (the contract's Pieces); every answer is still
+// about the whole patch. Random graph patches stretched 3 .. 1000 times along x or y and
+// random rational ones stretched 50 times, against a reference of their own: the patch cut
+// by hand (restrictTo) into pieces of aspect about 1 along its long way, each sampled on a
+// 16 x 16 grid, the 6 best samples refined by the pattern search on their piece (at most
+// 4,000 steps: beside an edge it can crawl). Its distance is attained by a surface point,
+// so it is an upper bound; the search beating it by more than the tolerance is counted, and
+// every distance is compared with the patch searched whole (cutLongPatches false). The
+// returned (patch, u, v) is evaluated on the original patch; a quarter cylinder 100 long is
+// checked against its closed form; segment clearances are refuted by sampling wherever one
+// is proven, and checked at their point wherever one is violated.
+double piecewiseReference(const std::vector<BezierPatch>& pieces, Vec3 p, int grid) {
+  struct Sample {
+    double d;
+    std::size_t piece;
+    double u, v;
+  };
+  std::vector<Sample> samples;
+  for (std::size_t k = 0; k < pieces.size(); ++k)
+    for (int i = 0; i <= grid; ++i)
+      for (int j = 0; j <= grid; ++j) {
+        const double u = static_cast<double>(i) / grid, v = static_cast<double>(j) / grid;
+        samples.push_back({reference::distanceAt(pieces[k], p, u, v), k, u, v});
+      }
+  const std::size_t starts = std::min<std::size_t>(6, samples.size());
+  std::partial_sort(samples.begin(), samples.begin() + static_cast<std::ptrdiff_t>(starts), samples.end(),
+                    [](const Sample& a, const Sample& b) { return a.d < b.d; });
+  double best = samples[0].d;
+  for (std::size_t s = 0; s < starts; ++s) {
+    const Sample& start = samples[s];
+    best = std::min(best, reference::patternSearch(pieces[start.piece], p, start.u, start.v, 1.0 / grid, 4000));
+  }
+  return best;
+}
+
+TEST(SurfaceDistance, LongThinPatchesAnswerForTheWholePatch) {
+  std::mt19937_64 rng(2612);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int queries = 0, proven = 0, violated = 0, referenceMissed = 0;
+  const double stretches[] = {3.0, 10.0, 100.0, 1000.0};
+  for (int s = 0; s < 10; ++s) {
+    BezierPatch patch = s < 8 ? randomPatch(rng, 3, 3, false, {}) : test::randomRationalPatch(rng, 2, 3);
+    const double stretch = s < 8 ? stretches[s % 4] : 50.0;
+    // randomPatch runs x along v, randomRationalPatch along u.
+    const bool alongX = s % 2 == 0;
+    for (Vec3& c : patch.control) (alongX ? c.x : c.y) *= stretch;
+    const bool longWayU = (s < 8) != alongX;
+    std::vector<BezierPatch> pieces;
+    const int count = static_cast<int>(std::ceil(stretch));
+    for (int k = 0; k < count; ++k) {
+      const double a = static_cast<double>(k) / count, b = static_cast<double>(k + 1) / count;
+      pieces.push_back(longWayU ? restrictTo(patch, a, b, 0.0, 1.0) : restrictTo(patch, 0.0, 1.0, a, b));
+    }
+    const Surface surface = surfaceOf({patch});
+    const SurfaceDistance engine(surface);
+    DistanceOptions uncut;
+    uncut.cutLongPatches = false;
+    const SurfaceDistance whole(surface, uncut);
+    const double tol = engine.tolerance();
+    const double rounding = 1e-15 * 64.0 * surfaceScale(surface);
+    for (const Vec3& p : queryPoints(rng, surface, 30)) {
+      const std::string context = "surface " + std::to_string(s) + " point " + std::to_string(queries);
+      ++queries;
+      const ClosestPoint result = engine.closest(p);
+      const double reference = piecewiseReference(pieces, p, 16);
+      ASSERT_TRUE(result.converged) << context;
+      EXPECT_EQ(result.patch, 0u) << context;
+      EXPECT_LE(result.lowerBound, reference + rounding) << context;
+      EXPECT_LE(result.distance, reference + tol) << context;
+      if (result.distance < reference - tol) ++referenceMissed;
+      // The patch searched whole, as before the pieces: the same distance within the tolerance.
+      const ClosestPoint uncutResult = whole.closest(p);
+      ASSERT_TRUE(uncutResult.converged) << context;
+      EXPECT_NEAR(result.distance, uncutResult.distance, tol) << context;
+      EXPECT_LE(result.lowerBound, uncutResult.distance + rounding) << context;
+      ASSERT_GE(result.u, 0.0) << context;
+      ASSERT_LE(result.u, 1.0) << context;
+      ASSERT_GE(result.v, 0.0) << context;
+      ASSERT_LE(result.v, 1.0) << context;
+      EXPECT_LE(norm(point(patch, result.u, result.v) - result.point), rounding) << context;
+      // A segment from p with a clearance about its distance: a proof is refuted by any surface
+      // point nearer than the clearance to one of the segment's samples.
+      const Vec3 b = p + Vec3{unit(rng) - 0.5, unit(rng) - 0.5, unit(rng) - 0.5};
+      const double clearance = result.distance * (0.6 + 0.6 * unit(rng));
+      const SegmentClearance segment = engine.segmentClearance(p, b, clearance);
+      if (segment.verdict == Clearance::proven) {
+        ++proven;
+        for (int k = 0; k <= 8; ++k) {
+          const Vec3 q = p + (k / 8.0) * (b - p);
+          EXPECT_GE(piecewiseReference(pieces, q, 8), clearance - rounding) << context << " sample " << k;
+        }
+      } else if (segment.verdict == Clearance::violated) {
+        ++violated;
+        EXPECT_EQ(segment.patch, 0u) << context;
+        EXPECT_LE(norm(point(patch, segment.u, segment.v) - segment.point), rounding) << context;
+        const Vec3 ab = b - p;
+        const Vec3 nearest = p + std::clamp(dot(segment.point - p, ab) / dot(ab, ab), 0.0, 1.0) * ab;
+        EXPECT_LT(norm(segment.point - nearest), clearance + rounding) << context;
+      }
+    }
+  }
+  EXPECT_EQ(queries, 300);
+  // Beside an edge the reference's pattern search crawls (it bounds, it does not always
+  // converge); the uncut search is the check there.
+  EXPECT_LE(referenceMissed, 60) << " of " << queries;
+  EXPECT_GT(proven, 60);
+  EXPECT_GT(violated, 60);
+
+  // The quarter cylinder y^2 + z^2 = 1, y, z >= 0, x in [0, 100]: rational quadratic across,
+  // linear along (32 pieces). Over it the distance is | |(y, z)| - 1 |.
+  BezierPatch cylinder;
+  cylinder.degreeU = 2;
+  cylinder.degreeV = 1;
+  const double arcY[3] = {1.0, 1.0, 0.0}, arcZ[3] = {0.0, 1.0, 1.0}, arcW[3] = {1.0, std::sqrt(0.5), 1.0};
+  for (int j = 0; j <= 2; ++j)
+    for (int k = 0; k <= 1; ++k) {
+      cylinder.control.push_back({100.0 * k, arcY[j], arcZ[j]});
+      cylinder.weights.push_back(arcW[j]);
+    }
+  const SurfaceDistance engine(surfaceOf({cylinder}));
+  std::uniform_real_distribution<double> along(0.0, 100.0), angle(0.0, 0.5 * std::numbers::pi), radius(0.2, 3.0);
+  for (int i = 0; i < 400; ++i) {
+    const double a = angle(rng), r = radius(rng);
+    const Vec3 p{along(rng), r * std::cos(a), r * std::sin(a)};
+    const ClosestPoint result = engine.closest(p);
+    ASSERT_TRUE(result.converged) << i;
+    EXPECT_NEAR(result.distance, std::abs(r - 1.0), engine.tolerance() + 1e-12) << i;
+    EXPECT_LE(result.lowerBound, std::abs(r - 1.0) + 1e-12) << i;
+    EXPECT_NEAR(result.point.x, p.x, 1e-4) << i;
+    EXPECT_NEAR(norm(point(cylinder, result.u, result.v) - result.point), 0.0, 1e-12) << i;
+    EXPECT_NEAR(result.v, p.x / 100.0, 1e-6) << i;  // v runs along x
+  }
+}
+
 TEST(SurfaceDistance, FreeFunctionsAndErrors) {
   const Surface surface = exampleSurface("paper-1");
   const Vec3 p{1.5, 1.5, 5.0};

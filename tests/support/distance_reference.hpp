@@ -30,9 +30,12 @@ inline double distanceAt(const BezierPatch& patch, Vec3 p, double u, double v) {
 // move to the best if it improves, else halve h. It needs no derivatives, so it shares
 // nothing with the Newton polish of the code under test; with eight directions every
 // descent direction is within 22.5 degrees of one, so it stops only at a local minimum.
-inline double patternSearch(const BezierPatch& patch, Vec3 p, double u, double v, double h) {
+// `maxMoves` bounds the steps, moves and halvings (the search stops there with its best point, still an upper
+// bound): on a badly scaled piece it can crawl by steps far below its distance to the minimum.
+inline double patternSearch(const BezierPatch& patch, Vec3 p, double u, double v, double h,
+                            long maxMoves = std::numeric_limits<long>::max()) {
   double best = distanceAt(patch, p, u, v);
-  while (h > 1e-13) {
+  for (long moves = 0; h > 1e-13 && moves < maxMoves; ++moves) {
     double bestU = u;
     double bestV = v;
     for (int du = -1; du <= 1; ++du) {

@@ -56,6 +56,19 @@
 //         consecutive queries in one region (the drop envelope's proofs along a pass) reuse
 //         their nets and boxes instead of halving again. They are computed as the search
 //         would compute them, so every result is the same, bit for bit, whatever is kept.
+// Pieces: a cell is halved in u and v together, so on a long thin patch (a fillet along an
+//         edge, a strip) the cells stay as long and thin as the patch, and near a contact the
+//         search must halve the short way far below the size the long way needs: paper-1's
+//         patch stretched 100 times along x took 8 times as long to plan as when cut into 64
+//         pieces by hand. So each patch is first cut at 1/2 (bezier.hpp's subdivideU or V,
+//         u halvings first) along the longer way of its control net (the longest control
+//         polygon that way) until that way is at most twice the other, at most
+//         kMaxPieceHalvings times a way; each piece is searched as a patch (its own quadtree,
+//         its root box in the hierarchy), and results name the original patch and its
+//         parameters (the pieces span [k, k + 1] / 2^j, so the map back is exact). A piece's
+//         net carries the rounding of its halvings: the allowance counts them as cell depth,
+//         with the original patch's scale and weight ratio. A patch whose ways are within a
+//         factor 2 (the paper's surfaces, the teapot's patches) is one piece, unchanged.
 // Trimmed: a trimmed patch (surface.hpp's trims) counts only where its face is. Its cells
 //         are classified against the face's trimming arcs (face_trim.hpp's classifyCell,
 //         kept per thread): outside, dropped; inside, kept with no more classifying; on a
@@ -175,6 +188,11 @@ constexpr std::size_t kPatchesPerLeaf = 8;
 /// Control points in all the patches' prebuilt trees (24 bytes each): the trees' depth is
 /// lowered below DistanceOptions::treeDepth past it.
 constexpr std::size_t kTreePointsBudget = std::size_t{1} << 22;
+/// A long thin patch is cut into at most 2^kMaxPieceHalvings pieces along its long way (see
+/// the contract's Pieces), and a surface into at most kPiecesBudget pieces (or its patch
+/// count, when more): past it every patch's halvings are capped alike.
+constexpr int kMaxPieceHalvings = 7;
+constexpr std::size_t kPiecesBudget = std::size_t{1} << 16;
 
 struct DistanceOptions {
   /// Absolute tolerance on the distance (surface units, >= 0); 0 selects 1e-9 x the
@@ -184,6 +202,9 @@ struct DistanceOptions {
   int treeDepth = 4;
   /// Cells one query may bound before it stops unconverged (>= 1).
   std::size_t maxCells = 1'000'000;
+  /// Cut long thin patches into pieces (the contract's Pieces); false searches every patch
+  /// whole, as before the pieces (slower on such patches; for comparison).
+  bool cutLongPatches = true;
 };
 
 /// The closest point of the surface to a query point, with the proven bracket of the distance.
