@@ -37,6 +37,14 @@ struct Box {
   Vec3 hi;
 };
 
+// Where a piece lies in the surface's patch `original`: [u0, u0 + du] x [v0, v0 + dv] of its
+// parameters, du and dv powers of 2 (so the map back is exact), made by `splits` halvings.
+struct PieceOf {
+  std::uint32_t original = 0;
+  double u0 = 0.0, du = 1.0, v0 = 0.0, dv = 1.0;
+  int splits = 0;
+};
+
 // One patch's sub-patches to `levels - 1` halvings in u and v. Level L holds 4^L cells; the
 // cell (iu, iv), on [iu, iu + 1] x [iv, iv + 1] / 2^L, is at index iu 2^L + iv, its control
 // net at nets[L][index * stride], its axis-aligned box at boxes[L][index].
@@ -62,20 +70,17 @@ struct PatchTree {
   // missed the cache on every cell (a quarter of a trimmed face's plan). Null: untrimmed.
   std::shared_ptr<std::atomic<std::uint8_t>[]> places;
   std::vector<std::size_t> placeOffset;
-  // The piece of the surface's patch `original` this tree covers (SurfaceDistance cuts long
-  // thin patches, see the contract's Pieces): its net reparametrised to [0, 1]^2 (`patch`),
-  // and where it lies in the original's parameters, [u0, u0 + du] x [v0, v0 + dv], du and dv
-  // powers of 2 (so the map is exact). `splits` halvings made it; the rounding allowance
-  // counts them as cell depth, and `scale` and `weightRatio` are the original patch's.
+  // The piece of a surface's patch this tree covers (SurfaceDistance cuts long thin patches,
+  // see the contract's Pieces), its net reparametrised to [0, 1]^2 (`patch`); `scale` and
+  // `weightRatio` are the original patch's, and the rounding allowance counts piece.splits
+  // as cell depth.
   BezierPatch patch;
-  std::uint32_t original = 0;
-  double u0 = 0.0, du = 1.0, v0 = 0.0, dv = 1.0;
-  int splits = 0;
+  PieceOf piece;
 };
 
 // A piece's parameters in its original patch's.
-double originalU(const PatchTree& tree, double s) { return tree.u0 + s * tree.du; }
-double originalV(const PatchTree& tree, double t) { return tree.v0 + t * tree.dv; }
+double originalU(const PatchTree& tree, double s) { return tree.piece.u0 + s * tree.piece.du; }
+double originalV(const PatchTree& tree, double t) { return tree.piece.v0 + t * tree.piece.dv; }
 
 // A node of the hierarchy of the patches' root boxes: a leaf holds `count` patches
 // (nodePatches_[first, first + count)), an inner node two children. Its rounding allowance
@@ -97,6 +102,7 @@ namespace {
 using detail::Box;
 using detail::PatchNode;
 using detail::PatchTree;
+using detail::PieceOf;
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 constexpr int kMaxTreeDepth = 6;
@@ -711,7 +717,7 @@ double allowanceCoefficient(const PatchTree& tree, int depth) {
   // their errors, each of the polynomial net's order relative to w_max |p|_max and w_max,
   // are divided by w >= w_min, so at most 2 w_max / w_min times the polynomial allowance.
   const double quotient = tree.rational ? 2.0 * tree.weightRatio + 1.0 : 1.0;
-  return quotient * (3.0 * (tree.degreeU + tree.degreeV) * (depth + tree.splits + 1) + 16.0) * kUnitRoundoff;
+  return quotient * (3.0 * (tree.degreeU + tree.degreeV) * (depth + tree.piece.splits + 1) + 16.0) * kUnitRoundoff;
 }
 
 double cellAllowance(const PatchTree& tree, int depth, double queryScale) {
@@ -964,20 +970,23 @@ void checkSurface(const Surface& surface) {
   }
 }
 
-PatchTree buildTree(const BezierPatch& patch, int depth) {
+// The tree of a piece (`patch`) of the surface's patch `original` (the same patch when it is
+// whole), whose scale and weight ratio set the rounding allowance.
+PatchTree buildTree(const BezierPatch& patch, const BezierPatch& original, const PieceOf& piece, int depth) {
   PatchTree tree;
+  tree.piece = piece;
   tree.degreeU = patch.degreeU;
   tree.degreeV = patch.degreeV;
   tree.points = patch.control.size();
   tree.rational = patch.rational();
   tree.stride = tree.rational ? 2 * tree.points : tree.points;
   tree.levels = depth + 1;
-  for (const Vec3& c : patch.control) tree.scale = std::max(tree.scale, maxAbs(c));
+  for (const Vec3& c : original.control) tree.scale = std::max(tree.scale, maxAbs(c));
   tree.nets.resize(static_cast<std::size_t>(tree.levels));
   tree.boxes.resize(static_cast<std::size_t>(tree.levels));
   tree.nets[0] = patch.control;
   if (tree.rational) {
-    const auto [least, largest] = std::minmax_element(patch.weights.begin(), patch.weights.end());
+    const auto [least, largest] = std::minmax_element(original.weights.begin(), original.weights.end());
     tree.weightRatio = *largest / *least;
     for (const double w : patch.weights) tree.nets[0].push_back({w, 0.0, 0.0});
   }
@@ -1013,9 +1022,7 @@ PatchTree buildTree(const BezierPatch& patch, int depth) {
 // Long thin patches cut into pieces (see the contract's Pieces).
 struct CutPiece {
   BezierPatch patch;
-  std::uint32_t original = 0;
-  double u0 = 0.0, du = 1.0, v0 = 0.0, dv = 1.0;
-  int splits = 0;
+  PieceOf of;
 };
 
 // The longest of a net's control polygons along u (alongU) or v: a bound on the length of
@@ -1057,7 +1064,7 @@ std::vector<CutPiece> cutLongPatches(const Surface& surface, bool cut) {
   for (std::size_t i = 0; i < surface.patches.size(); ++i) {
     const int ku = std::min(wanted[i].first, cap), kv = std::min(wanted[i].second, cap);
     const std::size_t first = pieces.size();
-    pieces.push_back({surface.patches[i], static_cast<std::uint32_t>(i), 0.0, 1.0, 0.0, 1.0, 0});
+    pieces.push_back({surface.patches[i], PieceOf{static_cast<std::uint32_t>(i)}});
     // Halved at 1/2 (de Casteljau, as the cells are), u first: the pieces in u-major order.
     for (int level = 0; level < ku + kv; ++level) {
       const bool inU = level < ku;
@@ -1065,21 +1072,14 @@ std::vector<CutPiece> cutLongPatches(const Surface& surface, bool cut) {
       std::vector<CutPiece> halves;
       halves.reserve(2 * (end - first));
       for (std::size_t k = first; k < end; ++k) {
-        const CutPiece& piece = pieces[k];
-        auto [low, high] = inU ? subdivideU(piece.patch, 0.5) : subdivideV(piece.patch, 0.5);
-        CutPiece a = piece, b = piece;
-        a.patch = std::move(low);
-        b.patch = std::move(high);
-        if (inU) {
-          a.du = b.du = 0.5 * piece.du;
-          b.u0 = piece.u0 + a.du;
-        } else {
-          a.dv = b.dv = 0.5 * piece.dv;
-          b.v0 = piece.v0 + a.dv;
-        }
-        a.splits = b.splits = piece.splits + 1;
-        halves.push_back(std::move(a));
-        halves.push_back(std::move(b));
+        auto [low, high] = inU ? subdivideU(pieces[k].patch, 0.5) : subdivideV(pieces[k].patch, 0.5);
+        PieceOf a = pieces[k].of;
+        ++a.splits;
+        (inU ? a.du : a.dv) *= 0.5;
+        PieceOf b = a;
+        (inU ? b.u0 : b.v0) += inU ? a.du : a.dv;
+        halves.push_back({std::move(low), a});
+        halves.push_back({std::move(high), b});
       }
       pieces.resize(first);
       for (CutPiece& half : halves) pieces.push_back(std::move(half));
@@ -1111,7 +1111,7 @@ struct TrimCellCache {
 bool classifyForTrim(const std::vector<PatchTrim>* trims, std::uint64_t id, const PatchTree& tree,
                      CellStore& store, Cell& cell) {
   if (cell.inFace) return true;
-  if (trims == nullptr || !(*trims)[tree.original].trimmed()) {
+  if (trims == nullptr || !(*trims)[tree.piece.original].trimmed()) {
     cell.inFace = true;  // all of an untrimmed patch is surface
     return true;
   }
@@ -1138,7 +1138,7 @@ bool classifyForTrim(const std::vector<PatchTrim>* trims, std::uint64_t id, cons
                     (TrimCellCache::kSlots - 1)];
     if (slot.id != id || slot.iu != iu || slot.iv != iv || slot.patch != cell.patch || slot.depth != cell.depth) {
       slot = {id, iu, iv, cell.patch, cell.depth,
-              classifyCell((*trims)[tree.original],
+              classifyCell((*trims)[tree.piece.original],
                            ParameterCell{originalU(tree, cell.u0), originalU(tree, cell.u0 + h), originalV(tree, cell.v0),
                                          originalV(tree, cell.v0 + h)})};
     }
@@ -1154,7 +1154,7 @@ bool classifyForTrim(const std::vector<PatchTrim>* trims, std::uint64_t id, cons
 
 // Whether a surface point of the piece counts (a trimmed patch's points outside its face do not).
 bool inFace(const std::vector<PatchTrim>* trims, const PatchTree& tree, double u, double v) {
-  return trims == nullptr || keepsPoint((*trims)[tree.original], originalU(tree, u), originalV(tree, v));
+  return trims == nullptr || keepsPoint((*trims)[tree.piece.original], originalU(tree, u), originalV(tree, v));
 }
 
 // The branch and bound of the contract (`scale`: the surface's, surfaceScale).
@@ -1275,7 +1275,7 @@ ClosestPoint search(const Surface& surface, double scale, const std::vector<Patc
   result.distance = best.distance;
   if (std::isfinite(best.distance)) {
     const PatchTree& tree = trees[best.patch];
-    result.patch = tree.original;
+    result.patch = tree.piece.original;
     result.u = originalU(tree, best.u);
     result.v = originalV(tree, best.v);
   }
@@ -1356,7 +1356,7 @@ SegmentClearance segmentSearch(const std::vector<PatchTree>& trees, const std::v
   const auto inOriginalPatch = [&trees](SegmentClearance found) {
     if (std::isfinite(found.distance)) {
       const PatchTree& tree = trees[found.patch];
-      found.patch = tree.original;
+      found.patch = tree.piece.original;
       found.u = originalU(tree, found.u);
       found.v = originalV(tree, found.v);
     }
@@ -1609,24 +1609,10 @@ SurfaceDistance::SurfaceDistance(const Surface& surface, const DistanceOptions& 
   while (depth > 0 && pointsAt(depth) > kTreePointsBudget) --depth;
   trees_.reserve(pieces.size());
   for (CutPiece& piece : pieces) {
-    const BezierPatch& original = surface_.patches[piece.original];
-    trees_.push_back(buildTree(piece.patch, depth));
+    trees_.push_back(buildTree(piece.patch, surface_.patches[piece.of.original], piece.of, depth));
     PatchTree& tree = trees_.back();
-    tree.original = piece.original;
-    tree.u0 = piece.u0;
-    tree.du = piece.du;
-    tree.v0 = piece.v0;
-    tree.dv = piece.dv;
-    tree.splits = piece.splits;
-    // The allowance is the original's: the piece's net carries the rounding of its splits.
-    tree.scale = 0.0;
-    for (const Vec3& c : original.control) tree.scale = std::max(tree.scale, maxAbs(c));
-    if (original.rational()) {
-      const auto [least, largest] = std::minmax_element(original.weights.begin(), original.weights.end());
-      tree.weightRatio = *largest / *least;
-    }
     tree.patch = std::move(piece.patch);
-    if (surface_.trimmed() && surface_.trims[piece.original].trimmed()) {
+    if (surface_.trimmed() && surface_.trims[piece.of.original].trimmed()) {
       std::size_t cells = 0;
       for (int level = 0; level < tree.levels; ++level) {
         tree.placeOffset.push_back(cells);
