@@ -29,6 +29,12 @@
 //                             the drop envelope's proofs. cut 1: long patches cut into pieces
 //                             (gouge.hpp's Pieces, the default), 0: searched whole, in the
 //                             same run; proofs per second and cells per proof
+//   BM_PatchJet/<d>/<one>     r and its derivatives to second order at 4,096 points (fixed
+//                             seed) of a random patch of bidegree (d, d): point() (de
+//                             Casteljau) then derivativesToSecondOrder (one 0: what the drop
+//                             envelope does on a bicubic patch), or both from one pass of
+//                             basis sums (one 1: what it and the distance search's Newton
+//                             steps do on any other); evaluations per second
 
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>
@@ -39,6 +45,7 @@
 #include <optional>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "scallop/geometry/bezier.hpp"
@@ -285,6 +292,37 @@ void BM_ClearanceLongPatch(benchmark::State& state) {
   state.SetLabel(fmt::format("stretched {}x, {}", state.range(0), state.range(1) == 1 ? "cut" : "whole"));
 }
 
+void BM_PatchJet(benchmark::State& state) {
+  const int degree = static_cast<int>(state.range(0));
+  const bool onePass = state.range(1) == 1;
+  std::mt19937_64 random(16);
+  std::uniform_real_distribution<double> coordinate(-2.0, 2.0), unit(0.0, 1.0);
+  scallop::BezierPatch patch{degree, degree, {}};
+  for (int i = 0; i < (degree + 1) * (degree + 1); ++i)
+    patch.control.push_back({coordinate(random), coordinate(random), coordinate(random)});
+  std::vector<std::pair<double, double>> at(4096);
+  for (auto& [u, v] : at) u = unit(random), v = unit(random);
+  for (auto _ : state) {
+    double sum = 0.0;
+    for (const auto& [u, v] : at) {
+      scallop::Vec3 r;
+      scallop::PatchDerivatives d;
+      if (onePass) {
+        d = scallop::derivativesToSecondOrder(patch, u, v, r);
+      } else {
+        r = scallop::point(patch, u, v);
+        d = scallop::derivativesToSecondOrder(patch, u, v);
+      }
+      sum += r.z + d.u.x + d.v.y + d.uu.z + d.uv.x + d.vv.y;
+    }
+    benchmark::DoNotOptimize(sum);
+  }
+  state.counters["evaluations_per_s"] =
+      benchmark::Counter(static_cast<double>(at.size()), benchmark::Counter::kIsIterationInvariantRate);
+  state.SetLabel(fmt::format("bidegree ({0}, {0}), {1}", degree, onePass ? "one pass" : "point + derivatives"));
+}
+
+BENCHMARK(BM_PatchJet)->ArgsProduct({{3, 5, 10, 20}, {0, 1}})->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_ClearanceLongPatch)->ArgsProduct({{1, 10, 100}, {0, 1}})->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_DistanceManyPatches)->Arg(1)->Arg(16)->Arg(256)->Arg(4096)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_DropCutter)->Args({1, 1})->Args({1, 0})->Args({2, 1})->Unit(benchmark::kMillisecond);

@@ -521,10 +521,12 @@ namespace {
 
 // The Bernstein bases of a patch's two directions at (u, v) with their first and second
 // derivatives: three rows per direction (value, first, second), su and sv apart; on the stack
-// up to degree 15. M, N >= 0 fix the degrees at compile time. Not copyable: bu points into it.
+// up to degree 20 (a surface's largest, kMaxPatchDegree in surface.hpp: the distance search
+// evaluates such patches millions of times), on the heap past it. M, N >= 0 fix the degrees
+// at compile time. Not copyable: bu points into it.
 template <int M = -1, int N = -1>
 struct BasisTable {
-  static constexpr int kSmall = 16;
+  static constexpr int kSmall = 21;
   int m, n, su, sv;
   std::array<double, 6 * kSmall> small;
   std::vector<double> large;
@@ -548,10 +550,11 @@ struct BasisTable {
   BasisTable& operator=(const BasisTable&) = delete;
 };
 
-// derivativesToSecondOrder's sums; M, N >= 0 fix the degrees at compile time (the same
+// derivativesToSecondOrder's sums, and r itself into *value when asked (the row sums with
+// the v basis weighed by the u basis); M, N >= 0 fix the degrees at compile time (the same
 // operations in the same order, unrolled).
 template <int M = -1, int N = -1>
-PatchDerivatives derivativesImpl(const BezierPatch& patch, double u, double v) {
+PatchDerivatives derivativesImpl(const BezierPatch& patch, double u, double v, Vec3* value = nullptr) {
   const BasisTable<M, N> basis(patch, u, v);
   const int m = M >= 0 ? M : basis.m;  // constants when fixed: the loops below unroll
   const int n = N >= 0 ? N : basis.n;
@@ -559,6 +562,7 @@ PatchDerivatives derivativesImpl(const BezierPatch& patch, double u, double v) {
   const double* bu = basis.bu;
   const double* bv = basis.bv;
   PatchDerivatives out{};
+  Vec3 r{};
   for (int j = 0; j <= m; ++j) {
     Vec3 row0{}, row1{}, row2{};  // the row's sums with the v basis and its derivatives
     for (int k = 0; k <= n; ++k) {
@@ -567,12 +571,14 @@ PatchDerivatives derivativesImpl(const BezierPatch& patch, double u, double v) {
       row1 = row1 + bv[sv + k] * p;
       row2 = row2 + bv[2 * sv + k] * p;
     }
+    r = r + bu[j] * row0;
     out.u = out.u + bu[su + j] * row0;
     out.v = out.v + bu[j] * row1;
     out.uu = out.uu + bu[2 * su + j] * row0;
     out.uv = out.uv + bu[su + j] * row1;
     out.vv = out.vv + bu[j] * row2;
   }
+  if (value != nullptr) *value = r;
   return out;
 }
 
@@ -643,9 +649,8 @@ PatchDerivatives derivativesToSecondOrder(const BezierPatch& patch, double u, do
 PatchDerivatives derivativesToSecondOrder(const BezierPatch& patch, double u, double v, Vec3& value) {
   requireValid(patch, "derivativesToSecondOrder");
   if (patch.rational()) return rationalDerivatives(patch, u, v, &value);
-  value = partial(patch, u, v, 0, 0);
-  if (patch.degreeU == 3 && patch.degreeV == 3) return derivativesImpl<3, 3>(patch, u, v);
-  return derivativesImpl<>(patch, u, v);
+  if (patch.degreeU == 3 && patch.degreeV == 3) return derivativesImpl<3, 3>(patch, u, v, &value);
+  return derivativesImpl<>(patch, u, v, &value);
 }
 
 double gaussianCurvatureNumeratorAt(const BezierPatch& patch, double u, double v) {

@@ -51,13 +51,24 @@ struct DropValue {
 
 DropValue dropValue(const BezierPatch& patch, double u, double v, double X, double Y, double R) {
   DropValue out;
-  const Vec3 r = point(patch, u, v);
+  // A bicubic polynomial patch: its point first (de Casteljau, unrolled), the derivatives
+  // only where the ball reaches it. Any other: point and derivatives from one pass of basis
+  // sums (bezier.hpp), cheaper than de Casteljau's point alone at a high degree, and for a
+  // rational patch the very pass its point() runs.
+  const bool bicubic = !patch.rational() && patch.degreeU == 3 && patch.degreeV == 3;
+  Vec3 r;
+  PatchDerivatives d;
+  if (bicubic) {
+    r = point(patch, u, v);
+  } else {
+    d = derivativesToSecondOrder(patch, u, v, r);
+  }
   const double dx = r.x - X, dy = r.y - Y;
   const double q2 = R * R - dx * dx - dy * dy;
   if (!(q2 > 0.0)) return out;
   const double q = std::sqrt(q2);
   out.g = r.z + q;
-  const PatchDerivatives d = derivativesToSecondOrder(patch, u, v);
+  if (bicubic) d = derivativesToSecondOrder(patch, u, v);
   const double au = dx * d.u.x + dy * d.u.y;
   const double av = dx * d.v.x + dy * d.v.y;
   out.gu = d.u.z - au / q;

@@ -327,26 +327,14 @@ void halveTreeNet(const PatchTree& tree, const Vec3* net, Vec3* out) {
     }
 }
 
-// Value, first and second derivative of the degree-n curve b[0 .. n] at t (b is consumed):
+// Value, first and second derivative of the degree-N curve b[0 .. N] at t (b is consumed):
 // de Casteljau down to three points q0, q1, q2; then r = the quadratic's value,
-// r' = n (e1 - e0) from the last level but one, r'' = n (n - 1) (q2 - 2 q1 + q0).
+// r' = N (e1 - e0) from the last level but one, r'' = N (N - 1) (q2 - 2 q1 + q0).
 struct CurveJet {
   Vec3 d0, d1, d2;
 };
-CurveJet curveJet(Vec3* b, int n, double t) {
-  const double s = 1.0 - t;
-  if (n == 1) return {s * b[0] + t * b[1], b[1] - b[0], {}};
-  for (int count = n + 1; count > 3; --count) {
-    for (int i = 0; i + 1 < count; ++i) b[i] = s * b[i] + t * b[i + 1];
-  }
-  const Vec3 e0 = s * b[0] + t * b[1];
-  const Vec3 e1 = s * b[1] + t * b[2];
-  const double nn = n;
-  return {s * e0 + t * e1, nn * (e1 - e0), (nn * (nn - 1.0)) * (b[2] - 2.0 * b[1] + b[0])};
-}
 
-// The same with the degree fixed at compile time (the same operations, so the same bits).
-// Inlined by force into jetAt's seven calls (GCC 12 kept them calls: 2.5 % of the raster
+// The degree is fixed at compile time; inlined by force into jetAt's seven calls (GCC 12 kept them calls: 2.5 % of the raster
 // plan's instructions).
 template <int N>
 [[gnu::always_inline]] inline CurveJet curveJetFixed(Vec3* b, double t) {
@@ -366,43 +354,26 @@ struct Jet {
   Vec3 r, ru, rv, ruu, ruv, rvv;
 };
 Jet jetAt(const BezierPatch& patch, double u, double v) {
-  if (patch.rational()) {  // the quotient rule (bezier.hpp), value and derivatives in one pass
+  if (patch.rational() || patch.degreeU != 3 || patch.degreeV != 3) {
+    // One pass of basis sums (bezier.hpp): O(m^2 + n^2 + mn), where de Casteljau down each
+    // row is O(m n^2), ten times as much at degree 20. A rational patch by the quotient rule.
     Vec3 r;
     const PatchDerivatives d = derivativesToSecondOrder(patch, u, v, r);
     return {r, d.u, d.v, d.uu, d.uv, d.vv};
   }
-  const int m = patch.degreeU;
-  const int n = patch.degreeV;
-  if (m == 3 && n == 3) {  // bicubic, unrolled
-    std::array<Vec3, 4> row, value, dv, dvv;
-    for (int j = 0; j <= 3; ++j) {
-      std::copy_n(patch.control.begin() + j * 4, 4, row.begin());
-      const CurveJet c = curveJetFixed<3>(row.data(), v);
-      const auto k = static_cast<std::size_t>(j);
-      value[k] = c.d0;
-      dv[k] = c.d1;
-      dvv[k] = c.d2;
-    }
-    const CurveJet a = curveJetFixed<3>(value.data(), u);
-    const CurveJet b = curveJetFixed<3>(dv.data(), u);
-    const CurveJet c = curveJetFixed<3>(dvv.data(), u);
-    return {a.d0, a.d1, b.d0, a.d2, b.d1, c.d0};
-  }
-  std::array<Vec3, kMaxPatchDegree + 1> row;
-  std::array<Vec3, kMaxPatchDegree + 1> value;
-  std::array<Vec3, kMaxPatchDegree + 1> dv;
-  std::array<Vec3, kMaxPatchDegree + 1> dvv;
-  for (int j = 0; j <= m; ++j) {  // each row along v
-    std::copy_n(patch.control.begin() + j * (n + 1), n + 1, row.begin());
-    const CurveJet c = curveJet(row.data(), n, v);
+  // Bicubic, the usual patch: de Casteljau along each row, then across, unrolled.
+  std::array<Vec3, 4> row, value, dv, dvv;
+  for (int j = 0; j <= 3; ++j) {
+    std::copy_n(patch.control.begin() + j * 4, 4, row.begin());
+    const CurveJet c = curveJetFixed<3>(row.data(), v);
     const auto k = static_cast<std::size_t>(j);
     value[k] = c.d0;
     dv[k] = c.d1;
     dvv[k] = c.d2;
   }
-  const CurveJet a = curveJet(value.data(), m, u);  // then across the rows, along u
-  const CurveJet b = curveJet(dv.data(), m, u);
-  const CurveJet c = curveJet(dvv.data(), m, u);
+  const CurveJet a = curveJetFixed<3>(value.data(), u);
+  const CurveJet b = curveJetFixed<3>(dv.data(), u);
+  const CurveJet c = curveJetFixed<3>(dvv.data(), u);
   return {a.d0, a.d1, b.d0, a.d2, b.d1, c.d0};
 }
 

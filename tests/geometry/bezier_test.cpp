@@ -220,13 +220,14 @@ TEST(BezierEvaluate, PointAndDerivativesMatchExplicitSums) {
   constexpr std::array<std::pair<int, int>, 6> kOrders = {
       {{0, 0}, {1, 0}, {0, 1}, {2, 0}, {1, 1}, {0, 2}}};
   int checks = 0;
-  // Every bidegree up to (5, 5), and past the one-pass derivatives' stack buffers (degree 15
-  // on the stack, 16 and up on the heap).
+  // Every bidegree up to (5, 5), some higher ones, and past the one-pass derivatives' stack
+  // buffers (degree 20 on the stack, 21 and up on the heap).
   std::vector<std::pair<int, int>> bidegrees;
   for (int m = 1; m <= 5; ++m) {
     for (int n = 1; n <= 5; ++n) bidegrees.emplace_back(m, n);
   }
-  for (const auto& large : {std::pair{15, 15}, std::pair{16, 3}, std::pair{2, 16}, std::pair{17, 16}}) {
+  for (const auto& large : {std::pair{15, 15}, std::pair{16, 3}, std::pair{2, 16}, std::pair{17, 16},
+                            std::pair{20, 20}, std::pair{21, 3}, std::pair{2, 22}}) {
     bidegrees.push_back(large);
   }
   for (const auto& [m, n] : bidegrees) {
@@ -273,6 +274,16 @@ TEST(BezierEvaluate, PointAndDerivativesMatchExplicitSums) {
                   << "one pass, bidegree (" << m << ", " << n << "), order (" << a << ", " << b << ")";
               ++checks;
             }
+          }
+          // The point from the one pass's basis sums: the header's bound for them,
+          // gamma(4(m + n) + 2) sum |p_jk| b_j b_k (point() is de Casteljau's).
+          {
+            Vec3 value;
+            (void)scallop::derivativesToSecondOrder(p, u, v, value);
+            const auto [want, magnitude] = referencePartial(p, u, v, 0, 0);
+            const V3 tolerance = gamma(4 * (m + n) + 2) * derivativeScale(p, u, v, 0, 0) + kRefFactor(m, n) * magnitude;
+            ASSERT_TRUE(within(value, want, tolerance)) << "one-pass value, bidegree (" << m << ", " << n << ")";
+            ++checks;
           }
           // The coordinate polynomials evaluate by the same de Casteljau steps: bit for bit.
           const Vec3 at = scallop::point(p, u, v);
