@@ -301,7 +301,10 @@ void BM_PatchJet(benchmark::State& state) {
   for (int i = 0; i < (degree + 1) * (degree + 1); ++i)
     patch.control.push_back({coordinate(random), coordinate(random), coordinate(random)});
   std::vector<std::pair<double, double>> at(4096);
-  for (auto& [u, v] : at) u = unit(random), v = unit(random);
+  for (auto& [u, v] : at) {
+    u = unit(random);
+    v = unit(random);
+  }
   for (auto _ : state) {
     double sum = 0.0;
     for (const auto& [u, v] : at) {

@@ -334,8 +334,8 @@ struct CurveJet {
   Vec3 d0, d1, d2;
 };
 
-// The degree is fixed at compile time; inlined by force into jetAt's seven calls (GCC 12 kept them calls: 2.5 % of the raster
-// plan's instructions).
+// The degree is fixed at compile time; inlined by force into jetAt's seven calls (GCC 12
+// kept them calls: 2.5 % of the raster plan's instructions).
 template <int N>
 [[gnu::always_inline]] inline CurveJet curveJetFixed(Vec3* b, double t) {
   static_assert(N >= 2);

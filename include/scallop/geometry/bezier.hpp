@@ -117,10 +117,11 @@ struct PatchDerivatives {
 };
 PatchDerivatives derivativesToSecondOrder(const BezierPatch& patch, double u, double v);
 /// The same and r(u, v) itself, in `value`, from the same pass: the basis sums
-/// sum_j b_j^m(u) sum_k b_k^n(v) p_jk (a rational patch's X / w), O(m^2 + n^2 + mn) where
-/// point()'s de Casteljau is O(mn(m + n)). Per coordinate |error| <= gamma_{4(m+n)+2}
+/// sum_j b_j^m(u) sum_k b_k^n(v) p_jk, O(m^2 + n^2 + mn) where point()'s de Casteljau is
+/// O(mn(m + n)). For a polynomial patch, per coordinate |error| <= gamma_{4(m+n)+2}
 /// sum_jk |p_jk| b_j(u) b_k(v) (the bases by their triangle, 3 roundings a level; the sums,
-/// one rounding a term and a level); it may differ from point() in the last bits.
+/// one rounding a term and a level), and it may differ from point() in the last bits; a
+/// rational patch's is X / w from the same sums, exactly what its point() returns.
 PatchDerivatives derivativesToSecondOrder(const BezierPatch& patch, double u, double v, Vec3& value);
 /// (r_uu . N)(r_vv . N) - (r_uv . N)^2 with N = r_u x r_v at (u, v): the value of
 /// gaussianCurvatureNumerator there, from derivativesToSecondOrder (cheaper than the
