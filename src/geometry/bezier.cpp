@@ -571,7 +571,7 @@ PatchDerivatives derivativesImpl(const BezierPatch& patch, double u, double v, V
       row1 = row1 + bv[sv + k] * p;
       row2 = row2 + bv[2 * sv + k] * p;
     }
-    r = r + bu[j] * row0;
+    if (value != nullptr) r = r + bu[j] * row0;  // only when asked: the other callers are hot too
     out.u = out.u + bu[su + j] * row0;
     out.v = out.v + bu[j] * row1;
     out.uu = out.uu + bu[2 * su + j] * row0;
