@@ -53,6 +53,31 @@ class PoleStack {
   void push(const Poles& poles) { copy(poles, slot()); }
   // Pops the top into `out`.
   void pop(Poles& out) { copy(entries_[--size_], out); }
+  // Pushes the piece [lo, hi] of `poles` (0 <= lo < hi <= 1), one level deeper: de Casteljau
+  // at lo keeping [lo, 1], then at (hi - lo) / (1 - lo) of that keeping its start. `poles`
+  // is used up.
+  void pushPiece(Poles& poles, double lo, double hi) {
+    const std::size_t n = poles.n;
+    auto& p = poles.p;
+    if (lo > 0.0) {
+      // In place, level by level: after level j, p[n-1-j] is the right piece's pole n-1-j,
+      // and later levels only write below it.
+      for (std::size_t level = 1; level < n; ++level)
+        for (std::size_t i = 0; i + level < n; ++i)
+          for (std::size_t c = 0; c < 3; ++c) p[i][c] = (1.0 - lo) * p[i][c] + lo * p[i + 1][c];
+    }
+    if (hi < 1.0) {
+      // Each level's points written from the top down, at the place of the later of the two
+      // they come from: after level j, p[j] is the left piece's pole j, and later levels only
+      // write above it.
+      const double t = (hi - lo) / (1.0 - lo);
+      for (std::size_t level = 1; level < n; ++level)
+        for (std::size_t i = n - 1; i >= level; --i)
+          for (std::size_t c = 0; c < 3; ++c) p[i][c] = (1.0 - t) * p[i - 1][c] + t * p[i][c];
+    }
+    ++poles.depth;
+    push(poles);
+  }
   // Pushes the two halves of `poles` at t = 1/2 (de Casteljau on the homogeneous poles): the
   // left half's poles are the first points of each level, the right half's the last
   // (reversed). `poles` is used up.
@@ -166,7 +191,67 @@ CellPlace classifyBox(const FaceTrim& trim, const ParameterBox& box) {
   return classifyPoint(trim, 0.5 * (box.u0 + box.u1), 0.5 * (box.v0 + box.v1));
 }
 
-bool mayMeet(const TrimArc& arc, const ParameterBox& box) {
+namespace {
+
+// Where on [0, 1] the function sum_i B_i(t) f_i (Bernstein polynomials of degree n - 1) may
+// be >= 0: the graph (t, f(t)) lies in the convex hull of the points (i / (n - 1), f_i), so
+// f(t) >= 0 only for t between the least and the largest t of that hull's part where f >= 0,
+// whose extremes are points with f_i >= 0 or crossings of f = 0 by the segment of two points
+// of opposite signs (every pair is tried: n <= kMaxTrimPoles). Narrows [lo, hi] to it;
+// false when it is empty.
+bool clipToNonNegative(const std::array<double, kMaxTrimPoles>& f, std::size_t n, double& lo, double& hi) {
+  // Most sides lie wholly to one side of the piece's poles: nothing to narrow, or nothing left.
+  std::size_t nonNegative = 0;
+  for (std::size_t i = 0; i < n; ++i) nonNegative += f[i] >= 0.0 ? 1 : 0;
+  if (nonNegative == n) return true;
+  if (nonNegative == 0) return false;
+  double least = std::numeric_limits<double>::infinity(), largest = -least;
+  const double step = 1.0 / static_cast<double>(n - 1);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!(f[i] >= 0.0)) continue;
+    least = std::min(least, static_cast<double>(i) * step);
+    largest = std::max(largest, static_cast<double>(i) * step);
+    for (std::size_t j = 0; j < n; ++j) {
+      if (f[j] >= 0.0) continue;
+      const double ti = static_cast<double>(i) * step, tj = static_cast<double>(j) * step;
+      const double t = ti + (tj - ti) * (f[i] / (f[i] - f[j]));
+      least = std::min(least, t);
+      largest = std::max(largest, t);
+    }
+  }
+  lo = std::max(lo, least);
+  hi = std::min(hi, largest);
+  return lo <= hi;
+}
+
+// The part of the arc's parameter interval where it may lie in the box (Bezier clipping,
+// Sederberg and Nishita 1990): u >= u0 is w u - u0 w >= 0 (w > 0), a Bernstein polynomial in
+// t whose coefficients are the poles' w u - u0 w; so for the box's four sides. Widened by
+// kClipSlack (the rounding of the crossings and of the piece's parameters); false when the
+// arc provably misses the box.
+bool clipToBox(const Poles& poles, const ParameterBox& box, double& lo, double& hi) {
+  constexpr double kClipSlack = 1e-9;
+  const std::size_t n = poles.n;
+  lo = 0.0, hi = 1.0;
+  std::array<double, kMaxTrimPoles> f;  // the first n written before they are read
+  const auto side = [&](std::size_t coordinate, double bound, double sign) {
+    for (std::size_t i = 0; i < n; ++i)
+      f[i] = sign * (poles.p[i][coordinate] - bound * poles.p[i][2]);
+    return clipToNonNegative(f, n, lo, hi);
+  };
+  if (!side(0, box.u0, 1.0) || !side(0, box.u1, -1.0) || !side(1, box.v0, 1.0) || !side(1, box.v1, -1.0))
+    return false;
+  lo = std::max(0.0, lo - kClipSlack);
+  hi = std::min(1.0, hi + kClipSlack);
+  return true;
+}
+
+}  // namespace
+
+namespace {
+
+// mayMeet's loop; `clip` false: halving alone (detail::mayMeetByHalving).
+bool mayMeetImpl(const TrimArc& arc, const ParameterBox& box, bool clip) {
   if (!poleBox(arc).meets(box)) return false;  // most arcs: no halving
   const double smallU = (box.u1 - box.u0) / 8.0, smallV = (box.v1 - box.v0) / 8.0;
   thread_local PoleStack stack;
@@ -178,10 +263,26 @@ bool mayMeet(const TrimArc& arc, const ParameterBox& box) {
     const ParameterBox own = boxOfPoles(poles.p, poles.n);
     if (!own.meets(box)) continue;
     if ((own.u1 - own.u0 <= smallU && own.v1 - own.v0 <= smallV) || poles.depth >= 40) return true;
-    stack.pushHalves(poles);
+    // The piece that may lie in the box, when that is at most half the arc (each step at
+    // least halves the parameter interval, so the depth still bounds it); else the halves.
+    double lo = 0.0, hi = 1.0;
+    if (clip && !clipToBox(poles, box, lo, hi)) continue;
+    if (hi - lo <= 0.5) {
+      stack.pushPiece(poles, lo, hi);
+    } else {
+      stack.pushHalves(poles);
+    }
   }
   return false;
 }
+
+}  // namespace
+
+bool mayMeet(const TrimArc& arc, const ParameterBox& box) { return mayMeetImpl(arc, box, true); }
+
+namespace detail {
+bool mayMeetByHalving(const TrimArc& arc, const ParameterBox& box) { return mayMeetImpl(arc, box, false); }
+}  // namespace detail
 
 AxisMap AxisMap::affine(double from, double to) {
   AxisMap map;

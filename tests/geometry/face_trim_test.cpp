@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <random>
 #include <string>
@@ -220,6 +221,111 @@ TEST(FaceTrim, PointsNearTheCurveAndOnIt) {
       EXPECT_EQ(scallop::classifyPoint(trim, end.u, end.v), CellPlace::boundary) << t;
     }
   }
+}
+
+// How one arc stands to one box by sampling, for mayMeet's reference: 1,024 chords over the
+// arc, each chord that may come near the box 1,024 times finer, twice (a parameter step of
+// 2^-30 near the box), until a sample lies in the box or the chords near it are below 1/64
+// of its sides. A piece's points are taken to lie within twice its chord of its ends
+// (the pieces are short beside the curve's bends); the Chebyshev distance (the larger of the
+// u and v gaps) is the measure.
+struct ArcNearBox {
+  bool sampleInBox = false;          // a sample lies in the box, 1e-12 inside each side
+  double lowerDistance = 1e300;      // a lower bound on the distance from the curve to `near`
+};
+
+double chebyshevGap(Point p, const ParameterBox& box) {
+  return std::max({box.u0 - p.u, p.u - box.u1, box.v0 - p.v, p.v - box.v1, 0.0});
+}
+
+void sampleNear(const TrimArc& arc, const ParameterBox& box, const ParameterBox& near, double t0, double t1,
+                int level, ArcNearBox& out) {
+  constexpr int kChords = 1024;
+  Point a = evaluate(arc, t0);
+  for (int k = 1; k <= kChords; ++k) {
+    const double ta = t0 + (t1 - t0) * (k - 1) / kChords, tb = t0 + (t1 - t0) * k / kChords;
+    const Point b = evaluate(arc, tb);
+    for (const Point& q : {a, b})
+      out.sampleInBox = out.sampleInBox || (q.u >= box.u0 + 1e-12 && q.u <= box.u1 - 1e-12 &&
+                                            q.v >= box.v0 + 1e-12 && q.v <= box.v1 - 1e-12);
+    if (out.sampleInBox) return;  // decided: mayMeet must say "may meet"
+    const double chord = std::max(std::abs(b.u - a.u), std::abs(b.v - a.v));
+    const double lower = std::min(chebyshevGap(a, near), chebyshevGap(b, near)) - 2.0 * chord;
+    // Finer only where it can still tell: a chord beside the box already below 1/64 of its
+    // sides is fine enough (the curve there is within the eighth either way).
+    const double side = std::min(box.u1 - box.u0, box.v1 - box.v0);
+    if (lower <= 0.0 && level < 2 && (side == 0.0 || chord > side / 64.0)) {
+      sampleNear(arc, box, near, ta, tb, level + 1, out);
+    } else {
+      out.lowerDistance = std::min(out.lowerDistance, lower);
+    }
+    a = b;
+  }
+}
+
+// mayMeet (and halving alone, its peer in scallop-bench) against dense sampling, on 2,000 random rational arcs of 1 to 9 poles (and some of
+// 20 to 32) with weights from 0.1 to 10, among them degenerate ones (every pole the same, all
+// on one line of constant v, repeated end poles), and boxes from a point to the arc's size
+// placed near it: "may meet" whenever a sample lies in the box, and "misses" whenever the
+// curve stays farther from the box than the contract's eighth of its size in u and v (the
+// pieces that answer "may meet" are that small and meet the box).
+TEST(FaceTrim, ArcsMeetBoxesAsDenseSamplesSay) {
+  std::mt19937_64 rng(19);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int meets = 0, misses = 0, between = 0, differ = 0;
+  for (int a = 0; a < 2000; ++a) {
+    const int kind = a % 10;
+    std::size_t n = 1 + static_cast<std::size_t>(unit(rng) * 9);
+    if (kind == 9) n = 20 + static_cast<std::size_t>(unit(rng) * 13);
+    std::vector<Point> poles;
+    std::vector<double> weights;
+    for (std::size_t i = 0; i < n; ++i) {
+      poles.push_back({2.0 * unit(rng) - 1.0, 2.0 * unit(rng) - 1.0});
+      weights.push_back(std::pow(10.0, 2.0 * unit(rng) - 1.0));
+    }
+    if (kind == 6) std::fill(poles.begin(), poles.end(), poles.front());  // a point
+    if (kind == 7)
+      for (Point& p : poles) p.v = 0.25;  // a line of constant v
+    if (kind == 8 && n >= 3) poles[1] = poles[0], poles[n - 2] = poles[n - 1];
+    const TrimArc arc = arcOf(poles, weights);
+    for (int b = 0; b < 4; ++b) {
+      const Point on = evaluate(arc, unit(rng));
+      const double size = b == 3 ? 0.0 : std::pow(10.0, -5.0 + 5.0 * unit(rng));
+      const double aspect = std::pow(10.0, 2.0 * unit(rng) - 1.0);
+      const double offset = std::pow(10.0, -6.0 + 6.0 * unit(rng)), angle = 2.0 * std::numbers::pi * unit(rng);
+      const double su = size * aspect, sv = size / aspect;
+      const double u0 = on.u + offset * std::cos(angle) - su * unit(rng);
+      const double v0 = on.v + offset * std::sin(angle) - sv * unit(rng);
+      const ParameterBox box{u0, u0 + su, v0, v0 + sv};
+      const ParameterBox near{box.u0 - su / 8.0, box.u1 + su / 8.0, box.v0 - sv / 8.0, box.v1 + sv / 8.0};
+      ArcNearBox reference;
+      sampleNear(arc, box, near, 0.0, 1.0, 0, reference);
+      const bool clipped = scallop::mayMeet(arc, box);
+      const bool halved = scallop::detail::mayMeetByHalving(arc, box);
+      for (int m = 0; m < 2; ++m) {
+        const bool may = m == 0 ? clipped : halved;
+        const char* method = m == 0 ? "mayMeet" : "by halving";
+        if (reference.sampleInBox) {
+          EXPECT_TRUE(may) << method << ": arc " << a << " box " << b;
+        } else if (reference.lowerDistance > 0.0 && size > 0.0) {
+          EXPECT_FALSE(may) << method << ": arc " << a << " box " << b << ": the curve stands "
+                            << reference.lowerDistance << " or more from the box widened by an eighth";
+        }
+      }
+      if (clipped != halved) ++differ;
+      if (reference.sampleInBox) {
+        ++meets;
+      } else if (reference.lowerDistance > 0.0) {
+        ++misses;
+      } else {
+        ++between;
+      }
+    }
+  }
+  EXPECT_GT(meets, 1500);
+  EXPECT_GT(misses, 4000);
+  std::printf("mayMeet: %d boxes met, %d missed, %d within an eighth of the box; clipping and halving differ on %d\n",
+              meets, misses, between, differ);
 }
 
 // Boxes: inside or outside only when every point of the box is (dense samples and the
