@@ -35,6 +35,10 @@
 //                             envelope does on a bicubic patch), or both from one pass of
 //                             basis sums (one 1: what it and the distance search's Newton
 //                             steps do on any other); evaluations per second
+//   BM_TrimMayMeet/<k>/<clip>  mayMeet of 4,096 boxes of side 2^-k near a circle of three
+//                             rational quadratic arcs (the trimmed disk's trim), against each
+//                             arc: Bezier clipping (clip 1, mayMeet) or halving alone (0, its
+//                             method before, detail::mayMeetByHalving); boxes per second
 
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>
@@ -49,6 +53,7 @@
 #include <vector>
 
 #include "scallop/geometry/bezier.hpp"
+#include "scallop/geometry/face_trim.hpp"
 #include "scallop/paths/contour.hpp"
 #include "scallop/paths/envelope.hpp"
 #include "scallop/io/gcode.hpp"
@@ -325,7 +330,45 @@ void BM_PatchJet(benchmark::State& state) {
   state.SetLabel(fmt::format("bidegree ({0}, {0}), {1}", degree, onePass ? "one pass" : "point + derivatives"));
 }
 
+// A circle of radius 1 as three rational quadratic arcs of 120 degrees (middle weight
+// cos 60 = 1/2), as OCCT converts one (the trimmed disk's trim); 4,096 square boxes of side
+// 2^-k centred on it, moved along its normal by up to two sides either way (fixed seed).
+void BM_TrimMayMeet(benchmark::State& state) {
+  const int k = static_cast<int>(state.range(0));
+  const bool clipping = state.range(1) == 1;
+  std::vector<scallop::TrimArc> arcs;
+  for (int a = 0; a < 3; ++a) {
+    const double from = 2.0 * std::acos(-1.0) * a / 3.0, to = from + 2.0 * std::acos(-1.0) / 3.0;
+    const double middle = 0.5 * (from + to), reach = 1.0 / std::cos(0.5 * (to - from));
+    arcs.push_back({{std::cos(from), std::sin(from), 1.0},
+                    {0.5 * reach * std::cos(middle), 0.5 * reach * std::sin(middle), 0.5},
+                    {std::cos(to), std::sin(to), 1.0}});
+  }
+  std::mt19937_64 random(19);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const double side = std::ldexp(1.0, -k);
+  std::vector<scallop::ParameterBox> boxes(4096);
+  for (scallop::ParameterBox& box : boxes) {
+    const double angle = 2.0 * std::acos(-1.0) * unit(random), radius = 1.0 + side * (4.0 * unit(random) - 2.0);
+    const double u = radius * std::cos(angle), v = radius * std::sin(angle);
+    box = {u - 0.5 * side, u + 0.5 * side, v - 0.5 * side, v + 0.5 * side};
+  }
+  std::size_t met = 0;
+  for (auto _ : state) {
+    met = 0;
+    for (const scallop::ParameterBox& box : boxes)
+      for (const scallop::TrimArc& arc : arcs)
+        met += (clipping ? scallop::mayMeet(arc, box) : scallop::detail::mayMeetByHalving(arc, box)) ? 1 : 0;
+    benchmark::DoNotOptimize(met);
+  }
+  state.counters["boxes_per_s"] =
+      benchmark::Counter(static_cast<double>(boxes.size()), benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["may_meet"] = static_cast<double>(met);
+  state.SetLabel(fmt::format("side 2^-{}, {}", k, clipping ? "clipping" : "halving alone"));
+}
+
 BENCHMARK(BM_PatchJet)->ArgsProduct({{3, 5, 10, 20}, {0, 1}})->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_TrimMayMeet)->ArgsProduct({{6, 12, 18}, {0, 1}})->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_ClearanceLongPatch)->ArgsProduct({{1, 10, 100}, {0, 1}})->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_DistanceManyPatches)->Arg(1)->Arg(16)->Arg(256)->Arg(4096)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_DropCutter)->Args({1, 1})->Args({1, 0})->Args({2, 1})->Unit(benchmark::kMillisecond);
