@@ -206,7 +206,7 @@ bool clipToNonNegative(const std::array<double, kMaxTrimPoles>& f, std::size_t n
   if (nonNegative == n) return true;
   if (nonNegative == 0) return false;
   double least = std::numeric_limits<double>::infinity(), largest = -least;
-  const double step = 1.0 / static_cast<double>(n - 1);
+  const double step = 1.0 / static_cast<double>(n - 1);  // n >= 2: the signs differ
   for (std::size_t i = 0; i < n; ++i) {
     if (!(f[i] >= 0.0)) continue;
     least = std::min(least, static_cast<double>(i) * step);
