@@ -1062,9 +1062,9 @@ std::vector<CutPiece> cutLongPatches(const Surface& surface, bool cut) {
 
 // Cells of trimmed patches classified, kept per thread across queries (keyed by the
 // SurfaceDistance's id, patch, depth and position): consecutive queries classify the same
-// cells, and classifying one halves the face's arcs down to its size. Emptied past 2^20.
-// The per-thread cache of trimmed cells' places: a direct-mapped table (a slot per hash,
-// overwritten on collision: a lost entry is classified again), no allocation per cell.
+// cells, and classifying one clips the face's arcs down to its size. A direct-mapped table
+// (a slot per hash, overwritten on collision: a lost entry is classified again, to the same
+// place), no allocation per cell.
 struct TrimCellCache {
   static constexpr std::size_t kSlots = std::size_t{1} << 18;
   struct Slot {
