@@ -46,6 +46,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <numbers>
 #include <optional>
 #include <random>
 #include <string>
@@ -338,7 +339,7 @@ void BM_TrimMayMeet(benchmark::State& state) {
   const bool clipping = state.range(1) == 1;
   std::vector<scallop::TrimArc> arcs;
   for (int a = 0; a < 3; ++a) {
-    const double from = 2.0 * std::acos(-1.0) * a / 3.0, to = from + 2.0 * std::acos(-1.0) / 3.0;
+    const double from = 2.0 * std::numbers::pi * a / 3.0, to = from + 2.0 * std::numbers::pi / 3.0;
     const double middle = 0.5 * (from + to), reach = 1.0 / std::cos(0.5 * (to - from));
     arcs.push_back({{std::cos(from), std::sin(from), 1.0},
                     {0.5 * reach * std::cos(middle), 0.5 * reach * std::sin(middle), 0.5},
@@ -349,7 +350,7 @@ void BM_TrimMayMeet(benchmark::State& state) {
   const double side = std::ldexp(1.0, -k);
   std::vector<scallop::ParameterBox> boxes(4096);
   for (scallop::ParameterBox& box : boxes) {
-    const double angle = 2.0 * std::acos(-1.0) * unit(random), radius = 1.0 + side * (4.0 * unit(random) - 2.0);
+    const double angle = 2.0 * std::numbers::pi * unit(random), radius = 1.0 + side * (4.0 * unit(random) - 2.0);
     const double u = radius * std::cos(angle), v = radius * std::sin(angle);
     box = {u - 0.5 * side, u + 0.5 * side, v - 0.5 * side, v + 0.5 * side};
   }

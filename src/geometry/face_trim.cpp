@@ -209,11 +209,12 @@ bool clipToNonNegative(const std::array<double, kMaxTrimPoles>& f, std::size_t n
   const double step = 1.0 / static_cast<double>(n - 1);  // n >= 2: the signs differ
   for (std::size_t i = 0; i < n; ++i) {
     if (!(f[i] >= 0.0)) continue;
-    least = std::min(least, static_cast<double>(i) * step);
-    largest = std::max(largest, static_cast<double>(i) * step);
+    const double ti = static_cast<double>(i) * step;
+    least = std::min(least, ti);
+    largest = std::max(largest, ti);
     for (std::size_t j = 0; j < n; ++j) {
       if (f[j] >= 0.0) continue;
-      const double ti = static_cast<double>(i) * step, tj = static_cast<double>(j) * step;
+      const double tj = static_cast<double>(j) * step;
       const double t = ti + (tj - ti) * (f[i] / (f[i] - f[j]));
       least = std::min(least, t);
       largest = std::max(largest, t);
@@ -228,27 +229,26 @@ bool clipToNonNegative(const std::array<double, kMaxTrimPoles>& f, std::size_t n
 // Sederberg and Nishita 1990): u >= u0 is w u - u0 w >= 0 (w > 0), a Bernstein polynomial in
 // t whose coefficients are the poles' w u - u0 w; so for the box's four sides. Widened by
 // kClipSlack (the rounding of the crossings and of the piece's parameters); false when the
-// arc provably misses the box.
-bool clipToBox(const Poles& poles, const ParameterBox& box, double& lo, double& hi) {
+// arc provably misses the box. `own` is the poles' box (the caller's): a side it lies wholly
+// within narrows nothing and is skipped.
+bool clipToBox(const Poles& poles, const ParameterBox& own, const ParameterBox& box, double& lo, double& hi) {
   constexpr double kClipSlack = 1e-9;
   const std::size_t n = poles.n;
   lo = 0.0, hi = 1.0;
   std::array<double, kMaxTrimPoles> f;  // the first n written before they are read
-  const auto side = [&](std::size_t coordinate, double bound, double sign) {
+  const auto side = [&](bool within, std::size_t coordinate, double bound, double sign) {
+    if (within) return true;
     for (std::size_t i = 0; i < n; ++i)
       f[i] = sign * (poles.p[i][coordinate] - bound * poles.p[i][2]);
     return clipToNonNegative(f, n, lo, hi);
   };
-  if (!side(0, box.u0, 1.0) || !side(0, box.u1, -1.0) || !side(1, box.v0, 1.0) || !side(1, box.v1, -1.0))
+  if (!side(own.u0 >= box.u0, 0, box.u0, 1.0) || !side(own.u1 <= box.u1, 0, box.u1, -1.0) ||
+      !side(own.v0 >= box.v0, 1, box.v0, 1.0) || !side(own.v1 <= box.v1, 1, box.v1, -1.0))
     return false;
   lo = std::max(0.0, lo - kClipSlack);
   hi = std::min(1.0, hi + kClipSlack);
   return true;
 }
-
-}  // namespace
-
-namespace {
 
 // mayMeet's loop; `clip` false: halving alone (detail::mayMeetByHalving).
 bool mayMeetImpl(const TrimArc& arc, const ParameterBox& box, bool clip) {
@@ -266,7 +266,7 @@ bool mayMeetImpl(const TrimArc& arc, const ParameterBox& box, bool clip) {
     // The piece that may lie in the box, when that is at most half the arc (each step at
     // least halves the parameter interval, so the depth still bounds it); else the halves.
     double lo = 0.0, hi = 1.0;
-    if (clip && !clipToBox(poles, box, lo, hi)) continue;
+    if (clip && !clipToBox(poles, own, box, lo, hi)) continue;
     if (hi - lo <= 0.5) {
       stack.pushPiece(poles, lo, hi);
     } else {

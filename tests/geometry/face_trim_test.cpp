@@ -263,12 +263,14 @@ void sampleNear(const TrimArc& arc, const ParameterBox& box, const ParameterBox&
   }
 }
 
-// mayMeet (and halving alone, its peer in scallop-bench) against dense sampling, on 2,000 random rational arcs of 1 to 9 poles (and some of
-// 20 to 32) with weights from 0.1 to 10, among them degenerate ones (every pole the same, all
-// on one line of constant v, repeated end poles), and boxes from a point to the arc's size
-// placed near it: "may meet" whenever a sample lies in the box, and "misses" whenever the
-// curve stays farther from the box than the contract's eighth of its size in u and v (the
-// pieces that answer "may meet" are that small and meet the box).
+// mayMeet (and halving alone, its peer in scallop-bench) against dense sampling, on 2,000
+// random rational arcs of 1 to 9 poles (and some of 20 to 32) with weights from 0.1 to 10,
+// among them degenerate ones (every pole the same, all on one line of constant v, repeated
+// end poles), and boxes from 1e-5 to the arc's size placed near it: "may meet" whenever a
+// sample lies in the box, and "misses" whenever the curve stays farther from the box than
+// the contract's eighth of its size in u and v (the pieces that answer "may meet" are that
+// small and meet the box): 8,000 boxes. A fifth box beside each arc is a point: no sample lies strictly inside it and
+// there is no eighth to miss by, so those are run only to end (no hang, no throw).
 TEST(FaceTrim, ArcsMeetBoxesAsDenseSamplesSay) {
   std::mt19937_64 rng(19);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
@@ -288,9 +290,9 @@ TEST(FaceTrim, ArcsMeetBoxesAsDenseSamplesSay) {
       for (Point& p : poles) p.v = 0.25;  // a line of constant v
     if (kind == 8 && n >= 3) poles[1] = poles[0], poles[n - 2] = poles[n - 1];
     const TrimArc arc = arcOf(poles, weights);
-    for (int b = 0; b < 4; ++b) {
+    for (int b = 0; b < 5; ++b) {
       const Point on = evaluate(arc, unit(rng));
-      const double size = b == 3 ? 0.0 : std::pow(10.0, -5.0 + 5.0 * unit(rng));
+      const double size = b == 4 ? 0.0 : std::pow(10.0, -5.0 + 5.0 * unit(rng));
       const double aspect = std::pow(10.0, 2.0 * unit(rng) - 1.0);
       const double offset = std::pow(10.0, -6.0 + 6.0 * unit(rng)), angle = 2.0 * std::numbers::pi * unit(rng);
       const double su = size * aspect, sv = size / aspect;
@@ -312,6 +314,7 @@ TEST(FaceTrim, ArcsMeetBoxesAsDenseSamplesSay) {
                             << reference.lowerDistance << " or more from the box widened by an eighth";
         }
       }
+      if (size == 0.0) continue;
       if (clipped != halved) ++differ;
       if (reference.sampleInBox) {
         ++meets;
@@ -322,8 +325,9 @@ TEST(FaceTrim, ArcsMeetBoxesAsDenseSamplesSay) {
       }
     }
   }
-  EXPECT_GT(meets, 1500);
-  EXPECT_GT(misses, 4000);
+  // Both answers are asserted often (the counts leave out the point boxes, which assert nothing).
+  EXPECT_GT(meets, 4000);
+  EXPECT_GT(misses, 2500);
   std::printf("mayMeet: %d boxes met, %d missed, %d within an eighth of the box; clipping and halving differ on %d\n",
               meets, misses, between, differ);
 }
