@@ -276,6 +276,14 @@ bool mayMeetImpl(const TrimArc& arc, const ParameterBox& box, bool clip) {
   return false;
 }
 
+// The image of the cell in the face's parameters, widened by the trim's margin.
+ParameterBox widenedImage(const PatchTrim& trim, const ParameterCell& cell) {
+  const double ua = trim.u.at(cell.u0), ub = trim.u.at(cell.u1);
+  const double va = trim.v.at(cell.v0), vb = trim.v.at(cell.v1);
+  return {std::min(ua, ub) - trim.margin, std::max(ua, ub) + trim.margin, std::min(va, vb) - trim.margin,
+          std::max(va, vb) + trim.margin};
+}
+
 }  // namespace
 
 bool mayMeet(const TrimArc& arc, const ParameterBox& box) { return mayMeetImpl(arc, box, true); }
@@ -330,11 +338,20 @@ void validateAxisMap(const AxisMap& map, const char* what) {
 
 CellPlace classifyCell(const PatchTrim& trim, const ParameterCell& cell) {
   if (!trim.trimmed()) return CellPlace::inside;
-  const double ua = trim.u.at(cell.u0), ub = trim.u.at(cell.u1);
-  const double va = trim.v.at(cell.v0), vb = trim.v.at(cell.v1);
-  const ParameterBox box{std::min(ua, ub) - trim.margin, std::max(ua, ub) + trim.margin,
-                         std::min(va, vb) - trim.margin, std::max(va, vb) + trim.margin};
-  return classifyBox(*trim.face, box);
+  return classifyBox(*trim.face, widenedImage(trim, cell));
+}
+
+bool cellMayMeetTrim(const PatchTrim& trim, const ParameterCell& cell) {
+  if (!trim.trimmed()) return false;
+  const ParameterBox box = widenedImage(trim, cell);
+  for (const TrimArc& arc : trim.face->arcs)
+    if (mayMeet(arc, box)) return true;
+  return false;
+}
+
+CellPlace placeOfPoint(const PatchTrim& trim, double s, double t) {
+  if (!trim.trimmed()) return CellPlace::inside;
+  return classifyPoint(*trim.face, trim.u.at(s), trim.v.at(t));
 }
 
 bool keepsPoint(const PatchTrim& trim, double s, double t) {

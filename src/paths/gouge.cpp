@@ -1094,7 +1094,39 @@ struct TrimCellCache {
     CellPlace place = CellPlace::boundary;
   };
   std::vector<Slot> slots = std::vector<Slot>(kSlots);
+  // The last point whose place was asked (placeOfCell): the four quarters of a split share it.
+  struct Point {
+    std::uint64_t id = 0;  // 0: none
+    std::size_t patch = 0;
+    double s = 0.0, t = 0.0;
+    CellPlace place = CellPlace::boundary;
+  } lastPoint;
 };
+
+// A trimmed cell's place (face_trim.hpp's classifyCell, but for the point it asks): boundary
+// when an arc may meet it, else the place of its corner at its parent's centre. A cell no arc
+// meets lies wholly on one side of the trim, so any of its points tells (placeOfPoint); that
+// corner is its three siblings' too, so the four quarters of a split cost one winding
+// computation, not four (on the disk half of the cells next to a trimming curve miss it). A
+// pure function of the cell, like the cache that keeps it: the same for any order of
+// queries and any thread.
+CellPlace placeOfCell(const PatchTrim& trim, std::uint64_t id, std::size_t patch, const PatchTree& tree,
+                      const Cell& cell, std::uint64_t iu, std::uint64_t iv, TrimCellCache& cache) {
+  const double h = cellSide(cell.depth);
+  const ParameterCell image{originalU(tree, cell.u0), originalU(tree, cell.u0 + h), originalV(tree, cell.v0),
+                            originalV(tree, cell.v0 + h)};
+  if (cellMayMeetTrim(trim, image)) return CellPlace::boundary;
+  // The parent's centre: a cell at an even position has it at its far corner (a root cell,
+  // at 0, at (1, 1)). cell.u0 + h is computed as its sibling's u0 was (parent u0 + half),
+  // so the siblings ask the very same point.
+  const double s = (iu & 1) != 0 ? image.u0 : image.u1;
+  const double t = (iv & 1) != 0 ? image.v0 : image.v1;
+  TrimCellCache::Point& last = cache.lastPoint;
+  if (last.id != id || last.patch != patch || last.s != s || last.t != t) {
+    last = {id, patch, s, t, placeOfPoint(trim, s, t)};
+  }
+  return last.place;
+}
 
 // A trimmed patch's cell (trims non-null and the patch trimmed, the cell not known inside):
 // false when it lies outside the face (dropped), else marks it when it lies inside. The place
@@ -1122,7 +1154,6 @@ bool classifyForTrim(const std::vector<PatchTrim>* trims, std::uint64_t id, cons
     place = static_cast<CellPlace>(known - 1);
   } else {
     thread_local TrimCellCache cache;
-    const double h = cellSide(cell.depth);
     const double cells = cellSide(-cell.depth);
     const auto iu = static_cast<std::uint64_t>(cell.u0 * cells), iv = static_cast<std::uint64_t>(cell.v0 * cells);
     // Cells classified one after another lie side by side (a cell's quarters, the next
@@ -1135,9 +1166,7 @@ bool classifyForTrim(const std::vector<PatchTrim>* trims, std::uint64_t id, cons
         cache.slots[(block << 6 | static_cast<std::size_t>((iu & 7) << 3 | (iv & 7))) & (TrimCellCache::kSlots - 1)];
     if (slot.id != id || slot.iu != iu || slot.iv != iv || slot.patch != cell.patch || slot.depth != cell.depth) {
       slot = {id, iu, iv, cell.patch, cell.depth,
-              classifyCell((*trims)[tree.piece.original],
-                           ParameterCell{originalU(tree, cell.u0), originalU(tree, cell.u0 + h), originalV(tree, cell.v0),
-                                         originalV(tree, cell.v0 + h)})};
+              placeOfCell((*trims)[tree.piece.original], id, tree.piece.original, tree, cell, iu, iv, cache)};
     }
     place = slot.place;
     const auto code = static_cast<std::uint8_t>(static_cast<std::uint8_t>(place) + 1);

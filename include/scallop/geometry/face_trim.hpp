@@ -159,6 +159,18 @@ struct PatchTrim {
 /// cell's image widened by the margin); inside for a patch that is not trimmed.
 CellPlace classifyCell(const PatchTrim& trim, const ParameterCell& cell);
 
+/// Whether some arc of the patch's face may meet the cell's image widened by the margin
+/// (mayMeet: false is proven); false for a patch that is not trimmed. classifyCell is
+/// boundary when this holds, else the place of the image's centre.
+bool cellMayMeetTrim(const PatchTrim& trim, const ParameterCell& cell);
+
+/// Where the point (s, t) of the patch's square lies with respect to its face (classifyPoint
+/// of its image); inside for a patch that is not trimmed. A cell for which cellMayMeetTrim is
+/// false lies wholly on one side of the trim (a closed box no arc meets is connected): any of
+/// its points, its corners included, gives its place, as its centre does (short of a gap
+/// between arcs' ends that the winding cannot close, where either may be boundary).
+CellPlace placeOfPoint(const PatchTrim& trim, double s, double t);
+
 /// Whether the point (s, t) of the patch's square belongs to the patch's part of its face:
 /// inside or on a trimming curve (classifyPoint's boundary); true for an untrimmed patch.
 bool keepsPoint(const PatchTrim& trim, double s, double t);
