@@ -70,8 +70,9 @@
 //         with the original patch's scale and weight ratio. A patch whose ways are within a
 //         factor 2 (the paper's surfaces, the teapot's patches) is one piece, unchanged.
 // Trimmed: a trimmed patch (surface.hpp's trims) counts only where its face is. Its cells
-//         are classified against the face's trimming arcs (face_trim.hpp's classifyCell,
-//         kept per thread): outside, dropped; inside, kept with no more classifying; on a
+//         are classified against the face's trimming arcs (face_trim.hpp's cellMayMeetTrim,
+//         then for a cell no arc meets placeOfPoint at its corner at its parent's centre,
+//         which its siblings share; kept per thread): outside, dropped; inside, kept with no more classifying; on a
 //         trimming curve, split like any cell but to kTrimCellDepth at most, their lower
 //         bounds (of the whole cell) standing there. Upper bounds are points of the face
 //         only (keepsPoint on every corner, centre and Newton point).
