@@ -611,13 +611,19 @@ void pushCell(std::vector<Cell>& heap, const Cell& cell, double lower) {
 // small region, so they would halve the same cells again. Keyed by the split cell (patch,
 // depth, iu, iv), each entry holds its four quarters' nets and boxes, computed exactly as
 // halveNet and boxOf compute them, so a query gives the same bits whatever the store holds.
-// Bounded: emptied at the start of a query once it holds kStoreEntries splits (or cells of
+// Bounded: emptied at the start of a query once it holds its limit of splits (or cells of
 // another SurfaceDistance, told apart by its id); within a query it grows with the cells
-// split (past kStoreEntries they are kept but no longer indexed). 1024 splits of bicubic
-// cells are 1.7 MB; on paper-1's raster plan 256 kept 1 % more instructions, 4096 and
-// 16384 no fewer (the drop envelope's proofs along a pass reuse only recent cells).
+// split (past the limit they are kept but no longer indexed). The limit is kStoreEntries,
+// kTrimmedStoreEntries for a trimmed surface. 1024 splits of bicubic cells are 1.7 MB; on
+// paper-1's raster plan 256 kept 1 % more instructions, 4096 and 16384 no fewer (the drop
+// envelope's proofs along a pass reuse only recent cells), and on paper-2's raster paths
+// 4096 took 1.04x the time (the nets no longer stay in the cache). A trimmed surface's
+// queries split the same cells along its trimming curves, 18 levels deep, again and again:
+// there 4096 took the screw's exact-trims paths 110 -> 86 s (32,768: no better), the disk's
+// 0.94x.
 constexpr std::size_t kStoreEntries = 1024;
-constexpr std::size_t kStoreSlots = 4 * kStoreEntries;  // a power of 2; at most 1/4 full
+constexpr std::size_t kTrimmedStoreEntries = 4096;
+constexpr std::size_t kStoreSlots = 4 * kTrimmedStoreEntries;  // a power of 2; at most 1/4 full
 
 // A cell's key (position iu, iv at its depth, in its patch) mixed into 64 bits.
 std::uint64_t mixCellKey(std::uint64_t iu, std::uint64_t iv, std::uint32_t patch, int depth) {
@@ -643,19 +649,24 @@ struct CellStore {
   std::size_t boxesUsed = 0;
   std::vector<Slot> slots = std::vector<Slot>(kStoreSlots);
   std::size_t entries = 0;
+  std::size_t limit = kStoreEntries;  // splits indexed; the slots in use are [0, 4 limit)
+  std::size_t mask = 4 * kStoreEntries - 1;
 
-  // Before a query of the SurfaceDistance `id`.
-  void prepare(std::uint64_t id) {
-    if (owner == id && entries < kStoreEntries && boxesUsed <= 4 * kStoreEntries) return;
+  // Before a query of the SurfaceDistance `id`, of a trimmed surface or not.
+  void prepare(std::uint64_t id, bool trimmed) {
+    const std::size_t wanted = trimmed ? kTrimmedStoreEntries : kStoreEntries;
+    if (owner == id && limit == wanted && entries < limit && boxesUsed <= 4 * limit) return;
     owner = id;
     netsUsed = 0;
     boxesUsed = 0;
-    if (entries > 0) std::fill(slots.begin(), slots.end(), Slot{});
+    if (entries > 0) std::fill(slots.begin(), slots.begin() + static_cast<std::ptrdiff_t>(mask + 1), Slot{});
     entries = 0;
+    limit = wanted;
+    mask = 4 * limit - 1;
   }
 
-  static std::size_t hash(std::uint64_t iu, std::uint64_t iv, std::uint32_t patch, int depth) {
-    return static_cast<std::size_t>(mixCellKey(iu, iv, patch, depth)) & (kStoreSlots - 1);
+  [[nodiscard]] std::size_t hash(std::uint64_t iu, std::uint64_t iv, std::uint32_t patch, int depth) const {
+    return static_cast<std::size_t>(mixCellKey(iu, iv, patch, depth)) & mask;
   }
 
   // The quarters of the cell (patch, depth, iu, iv) with the net `parent` (m, n its
@@ -664,7 +675,7 @@ struct CellStore {
   void quarters(std::uint32_t patch, int depth, std::uint64_t iu, std::uint64_t iv, const Vec3* parent,
                 const PatchTree& tree, std::size_t& net, std::uint32_t& box) {
     std::size_t slot = hash(iu, iv, patch, depth);
-    for (;; slot = (slot + 1) & (kStoreSlots - 1)) {
+    for (;; slot = (slot + 1) & mask) {
       const Slot& s = slots[slot];
       if (s.depth < 0) break;
       if (s.iu == iu && s.iv == iv && s.patch == patch && s.depth == depth) {
@@ -692,7 +703,7 @@ struct CellStore {
     }
     std::fill_n(places.begin() + box, 4, std::uint8_t{0});
     for (std::size_t k = 0; k < 4; ++k) boxes[box + k] = boxOf(nets.data() + net + k * stride, tree.points);
-    if (entries < kStoreSlots / 4) {
+    if (entries < limit) {
       slots[slot] = {iu, iv, patch, depth, net, box};
       ++entries;
     }
@@ -1196,7 +1207,7 @@ ClosestPoint search(const Surface& surface, double scale, const std::vector<Patc
   std::vector<Cell>& heap = scratch.heap;
   CellStore& store = scratch.store;
   heap.clear();
-  store.prepare(id);
+  store.prepare(id, surface.trimmed());
 
   Candidate best;
   double setAside = kInfinity;  // the least lower bound of the cells dropped
@@ -1375,7 +1386,7 @@ SegmentClearance segmentSearch(const std::vector<PatchTree>& trees, const std::v
   std::vector<Cell>& heap = scratch.heap;
   CellStore& store = scratch.store;
   heap.clear();
-  store.prepare(id);
+  store.prepare(id, trims != nullptr);
   SegmentClearance result;
   // The nearest point's piece and parameters as the surface's patch and its parameters.
   const auto inOriginalPatch = [&trees](SegmentClearance found) {
