@@ -127,6 +127,9 @@ double angleOutsideBox(const Range& poles, std::size_t n, double u, double v) {
   return angleBetween(a[0] / a[2] - u, a[1] / a[2] - v, b[0] / b[2] - u, b[1] / b[2] - v);
 }
 
+// Whether some arc of the trim may meet the box (mayMeet's: false is proven).
+bool anyArcMayMeet(const FaceTrim& trim, const ParameterBox& box);
+
 }  // namespace
 
 ParameterBox poleBox(const TrimArc& arc) { return boxOfPoles(arc, arc.size()); }
@@ -186,8 +189,7 @@ CellPlace classifyPoint(const FaceTrim& trim, double u, double v) {
 }
 
 CellPlace classifyBox(const FaceTrim& trim, const ParameterBox& box) {
-  for (const TrimArc& arc : trim.arcs)
-    if (mayMeet(arc, box)) return CellPlace::boundary;
+  if (anyArcMayMeet(trim, box)) return CellPlace::boundary;
   return classifyPoint(trim, 0.5 * (box.u0 + box.u1), 0.5 * (box.v0 + box.v1));
 }
 
@@ -276,6 +278,12 @@ bool mayMeetImpl(const TrimArc& arc, const ParameterBox& box, bool clip) {
   return false;
 }
 
+bool anyArcMayMeet(const FaceTrim& trim, const ParameterBox& box) {
+  for (const TrimArc& arc : trim.arcs)
+    if (mayMeetImpl(arc, box, true)) return true;
+  return false;
+}
+
 // The image of the cell in the face's parameters, widened by the trim's margin.
 ParameterBox widenedImage(const PatchTrim& trim, const ParameterCell& cell) {
   const double ua = trim.u.at(cell.u0), ub = trim.u.at(cell.u1);
@@ -343,10 +351,7 @@ CellPlace classifyCell(const PatchTrim& trim, const ParameterCell& cell) {
 
 bool cellMayMeetTrim(const PatchTrim& trim, const ParameterCell& cell) {
   if (!trim.trimmed()) return false;
-  const ParameterBox box = widenedImage(trim, cell);
-  for (const TrimArc& arc : trim.face->arcs)
-    if (mayMeet(arc, box)) return true;
-  return false;
+  return anyArcMayMeet(*trim.face, widenedImage(trim, cell));
 }
 
 CellPlace placeOfPoint(const PatchTrim& trim, double s, double t) {

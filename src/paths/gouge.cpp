@@ -619,7 +619,7 @@ void pushCell(std::vector<Cell>& heap, const Cell& cell, double lower) {
 // envelope's proofs along a pass reuse only recent cells), and on paper-2's raster paths
 // 4096 took 1.04x the time (the nets no longer stay in the cache). A trimmed surface's
 // queries split the same cells along its trimming curves, 18 levels deep, again and again:
-// there 4096 took the screw's exact-trims paths 110 -> 86 s (32,768: no better), the disk's
+// there 4096 took the screw's exact-trims paths 111 -> 93 s (32,768: no better), the disk's
 // 0.94x.
 constexpr std::size_t kStoreEntries = 1024;
 constexpr std::size_t kTrimmedStoreEntries = 4096;
@@ -650,7 +650,6 @@ struct CellStore {
   std::vector<Slot> slots = std::vector<Slot>(kStoreSlots);
   std::size_t entries = 0;
   std::size_t limit = kStoreEntries;  // splits indexed; the slots in use are [0, 4 limit)
-  std::size_t mask = 4 * kStoreEntries - 1;
 
   // Before a query of the SurfaceDistance `id`, of a trimmed surface or not.
   void prepare(std::uint64_t id, bool trimmed) {
@@ -659,14 +658,15 @@ struct CellStore {
     owner = id;
     netsUsed = 0;
     boxesUsed = 0;
-    if (entries > 0) std::fill(slots.begin(), slots.begin() + static_cast<std::ptrdiff_t>(mask + 1), Slot{});
+    if (entries > 0) std::fill(slots.begin(), slots.begin() + static_cast<std::ptrdiff_t>(4 * limit), Slot{});
     entries = 0;
     limit = wanted;
-    mask = 4 * limit - 1;
   }
 
+  [[nodiscard]] std::size_t mask() const { return 4 * limit - 1; }  // 4 limit: a power of 2
+
   [[nodiscard]] std::size_t hash(std::uint64_t iu, std::uint64_t iv, std::uint32_t patch, int depth) const {
-    return static_cast<std::size_t>(mixCellKey(iu, iv, patch, depth)) & mask;
+    return static_cast<std::size_t>(mixCellKey(iu, iv, patch, depth)) & mask();
   }
 
   // The quarters of the cell (patch, depth, iu, iv) with the net `parent` (m, n its
@@ -675,7 +675,7 @@ struct CellStore {
   void quarters(std::uint32_t patch, int depth, std::uint64_t iu, std::uint64_t iv, const Vec3* parent,
                 const PatchTree& tree, std::size_t& net, std::uint32_t& box) {
     std::size_t slot = hash(iu, iv, patch, depth);
-    for (;; slot = (slot + 1) & mask) {
+    for (;; slot = (slot + 1) & mask()) {
       const Slot& s = slots[slot];
       if (s.depth < 0) break;
       if (s.iu == iu && s.iv == iv && s.patch == patch && s.depth == depth) {
@@ -1118,11 +1118,12 @@ struct TrimCellCache {
 // when an arc may meet it, else the place of its corner at its parent's centre. A cell no arc
 // meets lies wholly on one side of the trim, so any of its points tells (placeOfPoint); that
 // corner is its three siblings' too, so the four quarters of a split cost one winding
-// computation, not four (on the disk half of the cells next to a trimming curve miss it). A
-// pure function of the cell, like the cache that keeps it: the same for any order of
+// computation, not four. A pure function of the cell, like the cache that keeps it: the same for any order of
 // queries and any thread.
-CellPlace placeOfCell(const PatchTrim& trim, std::uint64_t id, std::size_t patch, const PatchTree& tree,
-                      const Cell& cell, std::uint64_t iu, std::uint64_t iv, TrimCellCache& cache) {
+CellPlace placeOfCell(const std::vector<PatchTrim>& trims, std::uint64_t id, const PatchTree& tree, const Cell& cell,
+                      std::uint64_t iu, std::uint64_t iv, TrimCellCache& cache) {
+  const std::size_t patch = tree.piece.original;
+  const PatchTrim& trim = trims[patch];
   const double h = cellSide(cell.depth);
   const ParameterCell image{originalU(tree, cell.u0), originalU(tree, cell.u0 + h), originalV(tree, cell.v0),
                             originalV(tree, cell.v0 + h)};
@@ -1177,7 +1178,7 @@ bool classifyForTrim(const std::vector<PatchTrim>* trims, std::uint64_t id, cons
         cache.slots[(block << 6 | static_cast<std::size_t>((iu & 7) << 3 | (iv & 7))) & (TrimCellCache::kSlots - 1)];
     if (slot.id != id || slot.iu != iu || slot.iv != iv || slot.patch != cell.patch || slot.depth != cell.depth) {
       slot = {id, iu, iv, cell.patch, cell.depth,
-              placeOfCell((*trims)[tree.piece.original], id, tree.piece.original, tree, cell, iu, iv, cache)};
+              placeOfCell(*trims, id, tree, cell, iu, iv, cache)};
     }
     place = slot.place;
     const auto code = static_cast<std::uint8_t>(static_cast<std::uint8_t>(place) + 1);

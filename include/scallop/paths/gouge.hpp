@@ -72,10 +72,10 @@
 // Trimmed: a trimmed patch (surface.hpp's trims) counts only where its face is. Its cells
 //         are classified against the face's trimming arcs (face_trim.hpp's cellMayMeetTrim,
 //         then for a cell no arc meets placeOfPoint at its corner at its parent's centre,
-//         which its siblings share; kept per thread): outside, dropped; inside, kept with no more classifying; on a
-//         trimming curve, split like any cell but to kTrimCellDepth at most, their lower
-//         bounds (of the whole cell) standing there. Upper bounds are points of the face
-//         only (keepsPoint on every corner, centre and Newton point).
+//         which its siblings share; kept per thread): outside, dropped; inside, kept with no
+//         more classifying; on a trimming curve, split like any cell but to kTrimCellDepth
+//         at most, their lower bounds (of the whole cell) standing there. Upper bounds are
+//         points of the face only (keepsPoint on every corner, centre and Newton point).
 // Rational: a rational patch's cells keep their Euclidean control points (the cell lies in
 //         their convex hull, as the weights are positive) and weights; halving works on the
 //         homogeneous points w p and the weights, and divides back. Bounds 1 and 2 hold as
